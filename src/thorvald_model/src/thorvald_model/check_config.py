@@ -1,0 +1,112 @@
+"""``rosrun thorvald_model check_config FILE [FILE ...]``: validates robot configuration files.
+
+One file: a summary of the robot and its drives. Several files: one table row per robot.
+Invalid files: every problem, one per line, on stderr, and exit status 2.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+from typing import List, Optional
+
+from .config import RobotConfig, load_robot_config
+from .errors import ConfigError
+
+
+def summary(config: RobotConfig) -> dict:
+    """The figures a robot designer looks at first."""
+    passive = config.passive_wheels
+    return {
+        "robot": os.path.splitext(os.path.basename(config.source))[0],
+        "calculator": config.base_calculator,
+        "drives": len(config.drives),
+        "steered": len(config.steered_drives),
+        "driven": len(config.drives),
+        "passive": len(passive),
+        "casters": sum(1 for w in passive if not w.fixed),
+        "fixed": sum(1 for w in passive if w.fixed),
+        "suspended": sum(1 for d in config.drives if d.suspension is not None),
+        "track": round(config.track, 4),
+        "wheelbase": round(config.wheelbase, 4),
+        "batteries": len(config.batteries),
+    }
+
+
+TABLE_COLUMNS = (
+    # name, header, width, number format
+    ("robot", "robot", -28, ""),
+    ("drives", "drives", 7, ""),
+    ("steered", "steered", 8, ""),
+    ("driven", "driven", 7, ""),
+    ("passive", "passive", 8, ""),
+    ("track", "track [m]", 10, ".3f"),
+    ("wheelbase", "wheelbase [m]", 14, ".3f"),
+    ("calculator", "calculator", -0, ""),
+)
+
+
+def format_table(rows: List[dict]) -> str:
+    def cell(text, width):
+        return "  " + text if width == 0 else (text.ljust(-width) if width < 0 else text.rjust(width))
+
+    lines = ["".join(cell(head, width) for _, head, width, _ in TABLE_COLUMNS)]
+    for row in rows:
+        lines.append("".join(cell(format(row[name], fmt), width) for name, _, width, fmt in TABLE_COLUMNS))
+    return "\n".join(lines)
+
+
+def format_details(config: RobotConfig) -> str:
+    s = summary(config)
+    lines = [
+        f"{config.source}: valid robot configuration",
+        "  calculator  {}".format(s["calculator"]),
+        "  drives      {} ({} steered, {} driven, {} with suspension)".format(
+            s["drives"], s["steered"], s["driven"], s["suspended"]
+        ),
+        "  passive     {} wheels ({} casters, {} fixed)".format(s["passive"], s["casters"], s["fixed"]),
+        "  track       {:.3f} m, wheelbase {:.3f} m".format(s["track"], s["wheelbase"]),
+        "  batteries   {}".format(s["batteries"]),
+        "",
+        "  drive   node type   x [m]   y [m]  r [m]  str_lim [deg]  max speed [m/s]",
+    ]
+    for d in config.drives:
+        lines.append(
+            f"  {d.name:<7} {d.node:>4} {d.type:>4} {d.x:>7.3f} {d.y:>7.3f} {d.r_wheel:>6.3f}"
+            f" {math.degrees(d.str_lim):>14.1f} {d.max_wheel_speed:>16.2f}"
+        )
+    for w in config.passive_wheels:
+        lines.append(f"  {w.name:<7}    - {w.type[:4]:>4} {w.x:>7.3f} {w.y:>7.3f} {w.r_wheel:>6.3f}")
+    return "\n".join(lines)
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="check_config", description="Validate Thorvald robot configuration files and summarise the robots."
+    )
+    parser.add_argument("files", nargs="+", metavar="FILE", help="robot configuration YAML file(s)")
+    parser.add_argument("--json", action="store_true", help="print the summaries as JSON")
+    args = parser.parse_args(argv)
+
+    configs, failed = [], 0
+    for path in args.files:
+        try:
+            configs.append(load_robot_config(path))
+        except ConfigError as e:
+            failed += 1
+            print(e, file=sys.stderr)
+    if args.json:
+        print(json.dumps([summary(c) for c in configs], indent=2))
+    elif len(args.files) == 1 and configs:
+        print(format_details(configs[0]))
+    elif configs:
+        print(format_table([summary(c) for c in configs]))
+    if failed:
+        print(f"{failed} of {len(args.files)} file(s) invalid", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,867 @@
+"""The robot configuration file: schema, loader and validation.
+
+One file describes one robot (the paper's section 2.3). The format is the original's: top-level
+``base_calculator``, ``motor_drives: {drive0: {...}, ...}``, ``batteries``, ``pipes``, ``corners``,
+``beams`` and ``io``, with the original's keys. Keys of ours describe the modules the paper names
+that the original files lack: ``suspensions``, ``passive_wheels`` (casters and fixed support
+wheels) and ``frame_parts`` (custom frame members).
+
+Everything here is pure Python (no rospy, no messages): base_driver, the model generator and the
+simulator all load the same file through :func:`load_robot_config` so they agree on geometry.
+
+Loading never stops at the first mistake: every problem is collected, each with its dotted key
+path, the value and the rule, and raised together in one :class:`ConfigError`.
+"""
+
+import difflib
+import math
+import re
+from dataclasses import dataclass, field, replace
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple
+
+import yaml
+
+from .constants import DIFF_CALCULATOR, DRIVE_DIFF, DRIVE_STEERED, ONE_WHEEL_CALCULATOR, STD_CALCULATOR
+from .errors import MISSING, ConfigError, Problem
+from .layout import layout_problems
+
+# Top-level keys that robot files of users carry for their own xacro extras (LCAS sensor frames).
+# They are kept verbatim in RobotConfig.extras and not validated.
+PASSTHROUGH_KEYS = (
+    "extras",
+    "lidar_front",
+    "lidar_back",
+    "gnss_antenna_main",
+    "gnss_antenna_aux",
+    "imu",
+    "cameras",
+)
+
+FRAME_PART_COLORS = ("grey", "dark_grey", "black", "white", "silver", "orange", "red", "green", "blue", "yellow")
+
+
+# ---------------------------------------------------------------------------------------------
+# Value types (SI units: m, rad, s, kg; motor speeds stay in rpm, as the motor controllers use)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Suspension:
+    """A suspension module between a drive's steering module and the frame (paper 2.1.4)."""
+
+    name: str
+    index: int
+    drive: str  # name of the drive it carries, e.g. "drive0"
+    travel: float  # vertical travel [m]
+    stiffness: float  # spring rate [N/m]
+    damping: float  # [N s/m]
+
+
+@dataclass(frozen=True)
+class Drive:
+    """One drive module, ``motor_drives/driveN``."""
+
+    name: str
+    index: int
+    node: int  # CANopen node id of its motor controller
+    x: float  # steering axis position in base_link [m]
+    y: float  # [m]
+    type: int  # DRIVE_STEERED (0) or DRIVE_DIFF (1)
+    leg_mesh: int
+    r_wheel: float  # wheel radius [m]
+    w_wheel: float  # wheel width [m]
+    prp_gr_rt: float  # propulsion gear ratio (motor turns per wheel turn)
+    prp_enc_ppr: int  # propulsion encoder pulses per motor revolution
+    prp_max_rpm: float  # motor speed at full command [rpm]
+    prp_sim_a: float  # simulated propulsion acceleration [m/s^2]
+    str_gr_rt: float  # steering gear ratio
+    str_enc_ppr: int  # steering encoder pulses per motor revolution
+    str_lim: float  # steering angle limit, either side of straight ahead [rad]
+    str_sim_v: float  # simulated steering speed [rad/s]
+    steering_name: str  # joint name without tf_prefix, default "steeringN"
+    wheel_name: str  # joint name without tf_prefix, default "wheelN"
+    tower: bool  # a tower module stands above the drive (model only)
+    suspension: Optional[Suspension] = None
+
+    @property
+    def steerable(self) -> bool:
+        return self.type == DRIVE_STEERED
+
+    @property
+    def max_wheel_speed(self) -> float:
+        """Highest wheel rim speed the motor allows [m/s]."""
+        return self.prp_max_rpm * 2.0 * math.pi / 60.0 / self.prp_gr_rt * self.r_wheel
+
+
+@dataclass(frozen=True)
+class Battery:
+    """A battery enclosure, ``batteries/batN``; type 0 is an empty enclosure, 1 a KC battery."""
+
+    name: str
+    index: int
+    id: int  # battery CAN id (the original's deprecated node = id + 344); -1 for none
+    type: int
+    x: float
+    y: float
+    z: float
+    yaw: float
+    bat_mesh: int
+    with_battery: bool
+
+
+@dataclass(frozen=True)
+class Pipe:
+    """Two parallel frame tubes from (x1, y1) to (x2, y2), ``pipes/pipeN`` (model only)."""
+
+    name: str
+    index: int
+    x1: float
+    y1: float
+    x2: float
+    y2: float
+    height: float  # height of the middle between the two tubes [m]
+    space: float  # vertical distance between the tubes [m]
+
+    @property
+    def length(self) -> float:
+        return math.hypot(self.x2 - self.x1, self.y2 - self.y1)
+
+
+@dataclass(frozen=True)
+class Corner:
+    """A frame corner clamp, ``corners/cornerN`` (model only)."""
+
+    name: str
+    index: int
+    type: int  # orientation 0..3
+    corner_mesh: int
+    x: float
+    y: float
+    z: float
+    space: float
+    susp_ang: float  # [rad]
+
+
+@dataclass(frozen=True)
+class Beam:
+    """A frame beam between two drive modules, ``beams/beamN`` (model only)."""
+
+    name: str
+    index: int
+    start: str  # drive name
+    end: str  # drive name
+    height: float  # [m]
+
+
+@dataclass(frozen=True)
+class IOBoard:
+    """An IO board on the CAN bus, ``io/ioN``."""
+
+    name: str
+    index: int
+    id: int
+    type: int  # 0 main enclosure PCB, 1 sister enclosure PCB, 2 UV lamp board
+    rl0_init_state: bool
+    rl1_init_state: bool
+
+
+@dataclass(frozen=True)
+class PassiveWheel:
+    """An unpowered wheel, ``passive_wheels/passiveN`` (paper 2.1.5).
+
+    A ``caster`` swivels freely and constrains nothing; a ``fixed`` wheel rolls only along its
+    ``yaw`` and so cannot slide sideways, which confines the centre of rotation to its axle line.
+    """
+
+    name: str
+    index: int
+    type: str  # "caster" or "fixed"
+    x: float  # wheel contact (caster: swivel axis) in base_link [m]
+    y: float
+    r_wheel: float  # [m]
+    w_wheel: float  # [m]
+    yaw: float  # rolling direction of a fixed wheel in base_link [rad]
+    caster_offset: float  # horizontal trail from swivel axis to wheel centre [m]
+
+    @property
+    def fixed(self) -> bool:
+        return self.type == "fixed"
+
+
+@dataclass(frozen=True)
+class FramePart:
+    """A custom frame member, ``frame_parts/partN``: a box, cylinder or sphere (model only)."""
+
+    name: str
+    index: int
+    shape: str  # "box", "cylinder" or "sphere"
+    x: float  # centre in base_link [m]
+    y: float
+    z: float
+    roll: float  # [rad]
+    pitch: float
+    yaw: float
+    size_x: float  # box [m]
+    size_y: float
+    size_z: float
+    radius: float  # cylinder and sphere [m]
+    length: float  # cylinder, along its local z [m]
+    mass: float  # [kg]
+    color: str
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    """A validated robot configuration."""
+
+    source: str
+    base_calculator: str
+    drives: Tuple[Drive, ...]
+    batteries: Tuple[Battery, ...] = ()
+    pipes: Tuple[Pipe, ...] = ()
+    corners: Tuple[Corner, ...] = ()
+    beams: Tuple[Beam, ...] = ()
+    io: Tuple[IOBoard, ...] = ()
+    passive_wheels: Tuple[PassiveWheel, ...] = ()
+    suspensions: Tuple[Suspension, ...] = ()
+    frame_parts: Tuple[FramePart, ...] = ()
+    extras: Tuple[Tuple[str, Any], ...] = field(default=(), compare=False)
+
+    def drive(self, name: str) -> Drive:
+        for d in self.drives:
+            if d.name == name:
+                return d
+        raise KeyError(name)
+
+    @property
+    def steered_drives(self) -> Tuple[Drive, ...]:
+        return tuple(d for d in self.drives if d.steerable)
+
+    @property
+    def track(self) -> float:
+        """Widest lateral distance between two wheel contacts [m]."""
+        ys = [w[1] for w in self.wheel_contacts()]
+        return max(ys) - min(ys)
+
+    @property
+    def wheelbase(self) -> float:
+        """Longest longitudinal distance between two wheel contacts [m]."""
+        xs = [w[0] for w in self.wheel_contacts()]
+        return max(xs) - min(xs)
+
+    def wheel_contacts(self) -> List[Tuple[float, float]]:
+        return [(d.x, d.y) for d in self.drives] + [(w.x, w.y) for w in self.passive_wheels]
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The configuration in the file's format, with every default filled in."""
+        out = {"base_calculator": self.base_calculator}
+        for section in SECTIONS:
+            items = getattr(self, section.attr)
+            if items:
+                out[section.key] = {item.name: _item_to_dict(section, item) for item in items}
+        out.update(dict(self.extras))
+        return out
+
+    def with_drive_param(self, index: int, key: str, value: Any) -> "RobotConfig":
+        """A copy with ``motor_drives/drive<index>/<key>`` set to value, validated like a file."""
+        data = self.to_dict()
+        drives = data.get("motor_drives", {})
+        name = f"drive{index}"
+        if name not in drives:
+            raise ConfigError(self.source, [Problem("motor_drives." + name, MISSING, "no such drive")])
+        drives[name][key] = value
+        return parse_robot_config(data, self.source)
+
+
+# ---------------------------------------------------------------------------------------------
+# Schema
+# ---------------------------------------------------------------------------------------------
+REQUIRED = object()
+
+
+@dataclass(frozen=True)
+class Key:
+    """One key of a section entry: its type, default, rule and aliases."""
+
+    name: str
+    kind: type  # float, int, bool or str
+    default: Any = REQUIRED
+    check: Optional[Callable[[Any], bool]] = None
+    rule: str = ""
+    aliases: Tuple[str, ...] = ()
+    attr: Optional[str] = None  # dataclass field, when it differs from name
+
+
+def _positive(v):
+    return v > 0
+
+
+def _non_negative(v):
+    return v >= 0
+
+
+def _one_of(*choices):
+    return lambda v: v in choices
+
+
+def _in_range(lo, hi):
+    return lambda v: lo <= v <= hi
+
+
+POSITIVE = dict(check=_positive, rule="must be > 0")
+NON_NEGATIVE = dict(check=_non_negative, rule="must be >= 0")
+
+# The standard Thorvald II drive module: the values of every published robot file.
+DRIVE_KEYS = (
+    Key("node", int, check=_in_range(1, 127), rule="must be a CANopen node id in 1..127"),
+    Key("x", float),
+    Key("y", float),
+    Key("type", int, 0, _one_of(0, 1), "must be 0 (propulsion/steering) or 1 (propulsion/propulsion)"),
+    Key("leg_mesh", int, 0, _in_range(0, 6), "must be in 0..6"),
+    Key("r_wheel", float, 0.2, **POSITIVE),
+    Key("w_wheel", float, 0.16, **POSITIVE),
+    Key("prp_gr_rt", float, 42.0, **POSITIVE),
+    Key("prp_enc_ppr", int, 1024, **POSITIVE),
+    Key("prp_max_rpm", float, 3000.0, **POSITIVE),
+    Key("prp_sim_a", float, 1.5, aliases=("prp_slm_e",), **POSITIVE),
+    Key("str_gr_rt", float, 42.8571429, **POSITIVE),
+    Key("str_enc_ppr", int, 1024, **POSITIVE),
+    Key("str_lim", float, 3.078027759, lambda v: 0 < v <= math.pi, "must be in (0, pi] [rad]"),
+    Key("str_sim_v", float, 4.0, aliases=("str_slm_v",), **POSITIVE),
+    Key("steering_name", str, ""),
+    Key("wheel_name", str, ""),
+    Key("tower", bool, True),
+)
+
+BATTERY_KEYS = (
+    Key("id", int, None),
+    Key("node", int, None),  # deprecated: id = node - 344
+    Key("type", int, 1, _one_of(0, 1), "must be 0 (empty enclosure) or 1 (KC battery)"),
+    Key("x", float, 0.0),
+    Key("y", float, 0.0),
+    Key("z", float, 0.72),
+    Key("yaw", float, 0.0),
+    Key("bat_mesh", int, 0, **NON_NEGATIVE),
+    Key("with_battery", bool, True),
+)
+
+PIPE_KEYS = (
+    Key("x1", float),
+    Key("y1", float),
+    Key("x2", float),
+    Key("y2", float),
+    Key("height", float, 0.65, **POSITIVE),
+    Key("space", float, 0.15, **NON_NEGATIVE),
+)
+
+CORNER_KEYS = (
+    Key("type", int, 0, _in_range(0, 3), "must be in 0..3"),
+    Key("corner_mesh", int, 0, **NON_NEGATIVE),
+    Key("x", float),
+    Key("y", float),
+    Key("z", float, 0.65),
+    Key("space", float, 0.15, **NON_NEGATIVE),
+    Key("susp_ang", float, 0.0),
+)
+
+BEAM_KEYS = (
+    Key("start", str),
+    Key("end", str),
+    Key("height", float, 0.65, **POSITIVE),
+)
+
+IO_KEYS = (
+    Key("id", int, check=_non_negative, rule="must be >= 0"),
+    Key("type", int, 0, _in_range(0, 2), "must be 0 (main PCB), 1 (sister PCB) or 2 (UV lamp board)"),
+    Key("rl0_init_state", bool, False),
+    Key("rl1_init_state", bool, False),
+)
+
+PASSIVE_WHEEL_KEYS = (
+    Key("type", str, check=_one_of("caster", "fixed"), rule="must be 'caster' or 'fixed'"),
+    Key("x", float),
+    Key("y", float),
+    Key("r_wheel", float, 0.1, **POSITIVE),
+    Key("w_wheel", float, 0.05, **POSITIVE),
+    Key("yaw", float, 0.0),
+    Key("caster_offset", float, 0.05, **NON_NEGATIVE),
+)
+
+SUSPENSION_KEYS = (
+    Key("drive", str),
+    Key("travel", float, 0.1, **POSITIVE),
+    Key("stiffness", float, 30000.0, **POSITIVE),
+    Key("damping", float, 3000.0, **NON_NEGATIVE),
+)
+
+FRAME_PART_KEYS = (
+    Key("shape", str, check=_one_of("box", "cylinder", "sphere"), rule="must be 'box', 'cylinder' or 'sphere'"),
+    Key("x", float, 0.0),
+    Key("y", float, 0.0),
+    Key("z", float, 0.0),
+    Key("roll", float, 0.0),
+    Key("pitch", float, 0.0),
+    Key("yaw", float, 0.0),
+    Key("size_x", float, 0.0, **POSITIVE),
+    Key("size_y", float, 0.0, **POSITIVE),
+    Key("size_z", float, 0.0, **POSITIVE),
+    Key("radius", float, 0.0, **POSITIVE),
+    Key("length", float, 0.0, **POSITIVE),
+    Key("mass", float, **POSITIVE),
+    Key("color", str, "grey", _one_of(*FRAME_PART_COLORS), "must be one of " + ", ".join(FRAME_PART_COLORS)),
+)
+FRAME_PART_DIMENSIONS = {
+    "box": ("size_x", "size_y", "size_z"),
+    "cylinder": ("radius", "length"),
+    "sphere": ("radius",),
+}
+_ALL_DIMENSIONS = ("size_x", "size_y", "size_z", "radius", "length")
+
+
+@dataclass(frozen=True)
+class Section:
+    key: str  # top-level key, e.g. "motor_drives"
+    prefix: str  # entry prefix, e.g. "drive"
+    keys: Tuple[Key, ...]
+    cls: type
+    attr: str  # RobotConfig field
+
+
+SECTIONS = (
+    Section("motor_drives", "drive", DRIVE_KEYS, Drive, "drives"),
+    Section("batteries", "bat", BATTERY_KEYS, Battery, "batteries"),
+    Section("pipes", "pipe", PIPE_KEYS, Pipe, "pipes"),
+    Section("corners", "corner", CORNER_KEYS, Corner, "corners"),
+    Section("beams", "beam", BEAM_KEYS, Beam, "beams"),
+    Section("io", "io", IO_KEYS, IOBoard, "io"),
+    Section("passive_wheels", "passive", PASSIVE_WHEEL_KEYS, PassiveWheel, "passive_wheels"),
+    Section("suspensions", "susp", SUSPENSION_KEYS, Suspension, "suspensions"),
+    Section("frame_parts", "part", FRAME_PART_KEYS, FramePart, "frame_parts"),
+)
+TOP_LEVEL_KEYS = ("base_calculator", *(s.key for s in SECTIONS), *PASSTHROUGH_KEYS)
+
+
+# ---------------------------------------------------------------------------------------------
+# Loading
+# ---------------------------------------------------------------------------------------------
+def load_robot_config(path: str) -> RobotConfig:
+    """Loads and validates a robot configuration file; raises ConfigError naming every problem."""
+    try:
+        with open(path) as f:
+            data = yaml.safe_load(f)
+    except OSError as e:
+        raise ConfigError(path, [Problem("", MISSING, f"cannot read the file: {e.strerror}")]) from None
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        reason = getattr(e, "problem", None) or str(e)
+        raise ConfigError(path, [Problem("", MISSING, f"not valid YAML{where}: {reason}")]) from None
+    return parse_robot_config(data, path)
+
+
+def parse_robot_config(data: Any, source: str = "<robot configuration>", ignore: Iterable[str] = ()) -> RobotConfig:
+    """Validates an already parsed configuration (a YAML document or a ROS parameter tree).
+
+    ``ignore`` lists top-level keys that belong to something else (e.g. base_driver's own
+    parameters beside the robot configuration in its private namespace).
+    """
+    problems: List[Problem] = []
+    if data is None:
+        data = {}
+    if not isinstance(data, Mapping):
+        raise ConfigError(source, [Problem("", _short(data), "the file must hold a mapping of keys")])
+    ignore = set(ignore)
+    for key in data:
+        if key not in TOP_LEVEL_KEYS and key not in ignore:
+            problems.append(Problem(str(key), _short(data[key]), _unknown_key_rule(key, TOP_LEVEL_KEYS)))
+
+    calculator = data.get("base_calculator", STD_CALCULATOR)
+    if not isinstance(calculator, str) or not _CALCULATOR_NAME.match(calculator):
+        problems.append(
+            Problem(
+                "base_calculator",
+                calculator,
+                f"must name a calculator class, 'namespace::Class' (e.g. '{STD_CALCULATOR}') or 'python.module:Class'",
+            )
+        )
+
+    parsed = {}
+    for section in SECTIONS:
+        parsed[section.attr] = _parse_section(data.get(section.key), section, problems)
+
+    extras = tuple((k, data[k]) for k in PASSTHROUGH_KEYS if k in data)
+    drives = _attach_suspensions(parsed["drives"], parsed["suspensions"])
+    config = RobotConfig(
+        source=source,
+        base_calculator=calculator if isinstance(calculator, str) else STD_CALCULATOR,
+        drives=tuple(drives),
+        batteries=tuple(parsed["batteries"]),
+        pipes=tuple(parsed["pipes"]),
+        corners=tuple(parsed["corners"]),
+        beams=tuple(parsed["beams"]),
+        io=tuple(parsed["io"]),
+        passive_wheels=tuple(parsed["passive_wheels"]),
+        suspensions=tuple(parsed["suspensions"]),
+        frame_parts=tuple(parsed["frame_parts"]),
+        extras=extras,
+    )
+    problems.extend(_cross_field_problems(config, data))
+    if problems:
+        raise ConfigError(source, problems)
+    return config
+
+
+_CALCULATOR_NAME = re.compile(r"^(\w+::\w+|[A-Za-z_][\w.]*:\w+)$")
+_ENTRY_NAME = re.compile(r"^([a-z_]+?)(\d+)$")
+
+
+def _parse_section(raw: Any, section: Section, problems: List[Problem]) -> list:
+    if raw is None:
+        return []
+    if not isinstance(raw, Mapping):
+        problems.append(
+            Problem(section.key, _short(raw), f"must be a mapping of {section.prefix}0, {section.prefix}1, ...")
+        )
+        return []
+    indexed = {}
+    for name, entry in raw.items():
+        path = f"{section.key}.{name}"
+        m = _ENTRY_NAME.match(str(name))
+        if not m or m.group(1) != section.prefix or (len(m.group(2)) > 1 and m.group(2).startswith("0")):
+            problems.append(Problem(path, MISSING, f"entries must be named {section.prefix}0, {section.prefix}1, ..."))
+            continue
+        indexed[int(m.group(2))] = (str(name), _parse_entry(entry, path, section.keys, problems))
+    for expected, index in enumerate(sorted(indexed)):
+        if index != expected:
+            problems.append(
+                Problem(
+                    f"{section.key}.{section.prefix}{expected}",
+                    MISSING,
+                    f"entries must be numbered from {section.prefix}0 without gaps ({section.prefix}{index} is there)",
+                )
+            )
+            break
+    items = []
+    for index in sorted(indexed):
+        name, values = indexed[index]
+        if values is not None:
+            items.append(_build(section, name, index, values))
+    return items
+
+
+def _parse_entry(entry: Any, path: str, keys: Sequence[Key], problems: List[Problem]) -> Optional[dict]:
+    """The entry's values with defaults filled in; None if a required key is missing or invalid.
+
+    An invalid value of a key that has a default is replaced by the default after its problem is
+    recorded, so the cross-field rules can still look at the rest of the entry.
+    """
+    if not isinstance(entry, Mapping):
+        problems.append(Problem(path, _short(entry), "must be a mapping of keys"))
+        return None
+    by_name = {}
+    for key in keys:
+        by_name[key.name] = key
+        for alias in key.aliases:
+            by_name[alias] = key
+    values = {}
+    seen_as = {}
+    for raw_key, raw_value in entry.items():
+        key_path = f"{path}.{raw_key}"
+        key = by_name.get(raw_key)
+        if key is None:
+            problems.append(Problem(key_path, raw_value, _unknown_key_rule(raw_key, list(by_name))))
+            continue
+        if key.name in seen_as:
+            problems.append(Problem(key_path, raw_value, f"'{raw_key}' is already given as '{seen_as[key.name]}'"))
+            continue
+        seen_as[key.name] = raw_key
+        ok, value = _coerce(raw_value, key.kind)
+        if not ok:
+            problems.append(Problem(key_path, raw_value, f"must be {_KIND_NAMES[key.kind]}"))
+            continue
+        if key.check is not None and value is not None and not key.check(value):
+            problems.append(Problem(key_path, raw_value, key.rule))
+            continue
+        values[key.name] = value
+    complete = True
+    for key in keys:
+        if key.name in values:
+            continue
+        if key.default is not REQUIRED:
+            values[key.name] = key.default
+            continue
+        complete = False
+        if key.name not in seen_as:
+            problems.append(Problem(f"{path}.{key.name}", MISSING, "is required"))
+    return values if complete else None
+
+
+_KIND_NAMES = {float: "a finite number", int: "an integer", bool: "true or false (or 1 or 0)", str: "a string"}
+
+
+def _coerce(value: Any, kind: type) -> Tuple[bool, Any]:
+    """Converts a YAML value to kind; numbers written as strings ("-0.425") count as numbers."""
+    if kind is str:
+        return (True, value) if isinstance(value, str) else (False, None)
+    if kind is bool:
+        if isinstance(value, bool):
+            return True, value
+        if isinstance(value, int) and value in (0, 1):
+            return True, bool(value)
+        if isinstance(value, str) and value.strip().lower() in ("true", "false", "0", "1"):
+            return True, value.strip().lower() in ("true", "1")
+        return False, None
+    if isinstance(value, bool):
+        return False, None
+    if isinstance(value, str):
+        try:
+            value = float(value.strip())
+        except ValueError:
+            return False, None
+    if not isinstance(value, (int, float)) or not math.isfinite(value):
+        return False, None
+    if kind is int:
+        if float(value) != int(value):
+            return False, None
+        return True, int(value)
+    return True, float(value)
+
+
+def _unknown_key_rule(key: Any, known: Iterable[str]) -> str:
+    known = sorted(set(known))
+    close = difflib.get_close_matches(str(key), known, n=1, cutoff=0.6)
+    hint = f"did you mean '{close[0]}'?" if close else "known keys: {}".format(", ".join(known))
+    return f"unknown key ({hint})"
+
+
+def _build(section: Section, name: str, index: int, values: dict):
+    if section.cls is Drive:
+        values = dict(values)
+        values["steering_name"] = values["steering_name"] or f"steering{index}"
+        values["wheel_name"] = values["wheel_name"] or f"wheel{index}"
+    elif section.cls is Battery:
+        values = dict(values)
+        node = values.pop("node")
+        if values["id"] is None:
+            # The original's deprecated 'node' is the battery's CANopen node; its id is node - 344.
+            values["id"] = node - 344 if node is not None and node > 0 else -1
+    return section.cls(name=name, index=index, **values)
+
+
+def _item_to_dict(section: Section, item) -> dict:
+    out = {}
+    for key in section.keys:
+        if key.name == "node" and section.cls is Battery:
+            continue
+        if (
+            section.cls is FramePart
+            and key.name in _ALL_DIMENSIONS
+            and key.name not in FRAME_PART_DIMENSIONS[item.shape]
+        ):
+            continue
+        value = getattr(item, key.name)
+        if isinstance(value, float) and value.is_integer() and key.kind is int:
+            value = int(value)
+        out[key.name] = value
+    return out
+
+
+def _attach_suspensions(drives: List[Drive], suspensions: List[Suspension]) -> List[Drive]:
+    by_drive = {}
+    for s in suspensions:
+        by_drive.setdefault(s.drive, s)
+    return [replace(d, suspension=by_drive.get(d.name)) for d in drives]
+
+
+def _short(value: Any) -> Any:
+    text = repr(value)
+    return value if len(text) <= 60 else text[:57] + "..."
+
+
+# ---------------------------------------------------------------------------------------------
+# Cross-field rules
+# ---------------------------------------------------------------------------------------------
+SAME_SPOT_DISTANCE = 0.01  # [m]: closer wheel contacts are a typing mistake, not a design
+
+
+def _cross_field_problems(config: RobotConfig, data: Mapping) -> List[Problem]:
+    problems: List[Problem] = []
+    if not config.drives:
+        raw = data.get("motor_drives")
+        if not raw or not isinstance(raw, Mapping):  # a broken drive entry has its own problem already
+            problems.append(Problem("motor_drives", MISSING, "at least one driven wheel is needed"))
+        return problems
+
+    # Motor controllers: one per type-0 drive; one dual-channel controller per pair of type-1 drives.
+    nodes: Dict[int, List[Drive]] = {}
+    for d in config.drives:
+        nodes.setdefault(d.node, []).append(d)
+    for node, drives in nodes.items():
+        diff = [d for d in drives if d.type == DRIVE_DIFF]
+        steered = [d for d in drives if d.type == DRIVE_STEERED]
+        names = ", ".join(d.name for d in drives)
+        if diff and (len(diff) != 2 or steered):
+            for d in diff:
+                problems.append(
+                    Problem(
+                        f"motor_drives.{d.name}.node",
+                        node,
+                        f"type-1 drives come in pairs on one controller node; node {node} has: {names}",
+                    )
+                )
+        elif len(steered) > 1:
+            for d in steered[1:]:
+                problems.append(
+                    Problem(
+                        f"motor_drives.{d.name}.node",
+                        node,
+                        f"each type-0 drive has a motor controller of its own; node {node} is also {steered[0].name}'s",
+                    )
+                )
+
+    # Wheels: no two at one spot; steered wheels must not hit each other when they turn.
+    wheels = [("motor_drives." + d.name, d.x, d.y, d) for d in config.drives]
+    wheels += [("passive_wheels." + w.name, w.x, w.y, w) for w in config.passive_wheels]
+    for i, (path_a, xa, ya, a) in enumerate(wheels):
+        for path_b, xb, yb, b in wheels[i + 1 :]:
+            dist = math.hypot(xb - xa, yb - ya)
+            if dist < SAME_SPOT_DISTANCE:
+                problems.append(
+                    Problem(
+                        path_b,
+                        {"x": xb, "y": yb},
+                        f"no two wheels at one spot: {path_a} is {dist:.3f} m away",
+                    )
+                )
+            elif _turns(a) or _turns(b):
+                reach = _reach(a) + _reach(b)
+                if dist < reach:
+                    problems.append(
+                        Problem(
+                            path_b,
+                            {"x": xb, "y": yb},
+                            f"wheels collide when they turn: {path_a} is {dist:.3f} m away, less than the "
+                            f"{reach:.3f} m their footprints reach",
+                        )
+                    )
+
+    drive_names = {d.name for d in config.drives}
+    for beam in config.beams:
+        for end in ("start", "end"):
+            value = getattr(beam, end)
+            if value not in drive_names:
+                problems.append(Problem(f"beams.{beam.name}.{end}", value, "must name a drive of motor_drives"))
+        if beam.start == beam.end:
+            problems.append(Problem(f"beams.{beam.name}.end", beam.end, "must differ from start"))
+
+    carried = {}
+    for s in config.suspensions:
+        path = f"suspensions.{s.name}.drive"
+        if s.drive not in drive_names:
+            problems.append(Problem(path, s.drive, "must name a drive of motor_drives"))
+        elif s.drive in carried:
+            problems.append(Problem(path, s.drive, f"{carried[s.drive]} already carries {s.drive}"))
+        else:
+            carried[s.drive] = s.name
+
+    raw_batteries = data.get("batteries") if isinstance(data.get("batteries"), Mapping) else {}
+    battery_ids = {}
+    for b in config.batteries:
+        raw = raw_batteries.get(b.name, {}) if isinstance(raw_batteries, Mapping) else {}
+        node = raw.get("node") if isinstance(raw, Mapping) else None
+        path = f"batteries.{b.name}"
+        if "id" in raw and node is not None:
+            problems.append(Problem(path + ".node", node, "give 'id' or the deprecated 'node', not both"))
+        if b.type == 1 and b.with_battery:
+            if b.id < 1:
+                key = ".node" if node is not None else ".id"
+                value = node if node is not None else (raw.get("id", MISSING) if isinstance(raw, Mapping) else MISSING)
+                problems.append(Problem(path + key, value, "a KC battery (type 1) needs an id >= 1 (node >= 345)"))
+            elif b.id in battery_ids:
+                problems.append(Problem(path + ".id", b.id, "battery id also used by " + battery_ids[b.id]))
+            else:
+                battery_ids[b.id] = b.name
+
+    io_ids = {}
+    for board in config.io:
+        if board.id in io_ids:
+            problems.append(Problem(f"io.{board.name}.id", board.id, "IO board id also used by " + io_ids[board.id]))
+        io_ids.setdefault(board.id, board.name)
+
+    for pipe in config.pipes:
+        if pipe.length < SAME_SPOT_DISTANCE:
+            problems.append(
+                Problem(
+                    f"pipes.{pipe.name}",
+                    {"x1": pipe.x1, "y1": pipe.y1, "x2": pipe.x2, "y2": pipe.y2},
+                    "the two ends must differ",
+                )
+            )
+
+    raw_parts = data.get("frame_parts") if isinstance(data.get("frame_parts"), Mapping) else {}
+    for part in config.frame_parts:
+        raw = raw_parts.get(part.name, {})
+        needed = FRAME_PART_DIMENSIONS[part.shape]
+        for dim in needed:
+            if dim not in raw:
+                problems.append(
+                    Problem(
+                        f"frame_parts.{part.name}.{dim}",
+                        MISSING,
+                        "a {} needs {}".format(part.shape, ", ".join(needed)),
+                    )
+                )
+        for dim in _ALL_DIMENSIONS:
+            if dim in raw and dim not in needed:
+                problems.append(
+                    Problem(
+                        f"frame_parts.{part.name}.{dim}",
+                        raw[dim],
+                        "a {} has only {}".format(part.shape, ", ".join(needed)),
+                    )
+                )
+
+    problems.extend(layout_problems(config))
+    return problems
+
+
+def _turns(wheel) -> bool:
+    """A steered drive or a caster sweeps a circle about its vertical axis."""
+    return wheel.steerable if isinstance(wheel, Drive) else not wheel.fixed
+
+
+def _reach(wheel) -> float:
+    """How far a wheel's footprint reaches from its x, y, seen from above, as it turns [m].
+
+    A wheel of radius r and width w is a 2r x w rectangle from above; turning about its centre it
+    sweeps a circle of radius hypot(r, w/2); a caster's wheel centre trails caster_offset behind.
+    """
+    reach = math.hypot(wheel.r_wheel, wheel.w_wheel / 2.0)
+    if isinstance(wheel, PassiveWheel) and not wheel.fixed:
+        reach += wheel.caster_offset
+    return reach
+
+
+def drive_field_names() -> Tuple[str, ...]:
+    """Keys base_driver's set_drive_params may change (the drive dataclass fields of the file)."""
+    return tuple(k.name for k in DRIVE_KEYS)
+
+
+__all__ = [
+    "DIFF_CALCULATOR",
+    "DRIVE_DIFF",
+    "DRIVE_STEERED",
+    "ONE_WHEEL_CALCULATOR",
+    "STD_CALCULATOR",
+    "Battery",
+    "Beam",
+    "ConfigError",
+    "Corner",
+    "Drive",
+    "FramePart",
+    "IOBoard",
+    "PassiveWheel",
+    "Pipe",
+    "RobotConfig",
+    "Suspension",
+    "load_robot_config",
+    "parse_robot_config",
+]

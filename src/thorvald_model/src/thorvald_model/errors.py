@@ -1,0 +1,43 @@
+"""Errors of the thorvald_model package."""
+
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+
+class ThorvaldModelError(Exception):
+    """Base class of every error this package raises."""
+
+
+MISSING = object()
+"""Stands for the value of a key that is not in the file."""
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One broken rule of the robot configuration.
+
+    path: dotted key path, e.g. ``motor_drives.drive1.str_lim``
+    value: the offending value (``MISSING`` for an absent key)
+    rule: what the value must satisfy, in words
+    """
+
+    path: str
+    value: Any
+    rule: str
+
+    def format(self, source: str) -> str:
+        value = "<missing>" if self.value is MISSING else repr(self.value)
+        return "{}: {}: {}: {}".format(source, self.path or "<top level>", value, self.rule)
+
+
+class ConfigError(ThorvaldModelError):
+    """A robot configuration breaks one or more rules; every problem found is listed."""
+
+    def __init__(self, source: str, problems: Sequence[Problem]):
+        self.source = source
+        self.problems = tuple(problems)
+        lines = [p.format(source) for p in self.problems]
+        header = "{}: invalid robot configuration ({} problem{}):".format(
+            source, len(lines), "" if len(lines) == 1 else "s"
+        )
+        super().__init__("\n".join([header] + ["  " + line for line in lines]))

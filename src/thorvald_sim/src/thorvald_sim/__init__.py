@@ -1,0 +1,1 @@
+"""pybullet simulator of any Thorvald robot generated from its configuration file."""

@@ -1,0 +1,1 @@
+"""Hardware-independent joystick teleoperation of a Thorvald robot."""
