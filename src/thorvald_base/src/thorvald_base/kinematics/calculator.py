@@ -1,0 +1,166 @@
+"""The calculator interface of the original base_calculator plugins (notes section 3).
+
+A calculator turns a body twist into per-drive joint commands and measured drive states into
+odometry. It is pure: time and states come in as numbers. The shared logic lives here (template
+method, as python-can's ``recv``/``_recv_internal``); a calculator overrides ``_check_layout``
+and, if it has a cheaper form, ``_commands``.
+
+Lifecycle, as pluginlib's: construct with no arguments (or options), ``initialize(drives,
+passive_wheels)`` once, ``set_params(drives, passive_wheels)`` when parameters change at run time
+(the pose is kept), then ``calculate_command`` and ``calculate_odometry`` every cycle.
+"""
+
+import math
+from typing import List, Optional, Sequence
+
+from ..errors import KinematicsError
+from .geometry import Layout
+from .odometry import DEFAULT_ESTIMATOR, ESTIMATORS, integrate_se2, make_estimator
+from .types import CommandResult, DriveCommand, DriveState, OdometryResult, Pose, Twist
+
+MAX_ODOMETRY_DT = 0.5  # [s]: a longer gap between states is a pause, not motion (the original's rule)
+STOPPED_SPEED = 1e-9  # [m/s]: a wheel this slow has no direction of its own; it keeps its heading
+REALISABLE_TOLERANCE = 1e-9  # [m/s]: wheel-velocity change below which a twist counts as unchanged
+
+
+class BaseCalculator:
+    """Base class of every kinematics calculator plugin.
+
+    estimator: "lsq" (least-squares rigid-body fit, the default) or "paper" (random pairs);
+    seed: seed of the paper estimator's random pairs, for reproducible odometry.
+    """
+
+    def __init__(self, estimator: str = DEFAULT_ESTIMATOR, seed: Optional[int] = None):
+        if estimator not in ESTIMATORS:
+            raise KinematicsError("estimator must be one of {}, not {!r}".format(", ".join(ESTIMATORS), estimator))
+        self.estimator_name = estimator
+        self.seed = seed
+        self.layout: Optional[Layout] = None
+        self._estimator = None
+        self._last_steering: List[float] = []
+        self._pose = Pose()
+        self._last_time: Optional[float] = None
+
+    # ---- the original's interface ---------------------------------------------------------
+    def initialize(self, drives: Sequence, passive_wheels: Sequence = ()) -> None:
+        """Sets the drives (thorvald_model Drive) and passive wheels, and zeroes the pose."""
+        self.set_params(drives, passive_wheels)
+        self.zero_odometry_pose()
+        self._last_time = None
+
+    def set_params(self, drives: Sequence, passive_wheels: Optional[Sequence] = None) -> None:
+        """Replaces the drive parameters at run time (paper 3.1: e.g. a new wheel radius); keeps the pose.
+
+        passive_wheels None keeps the current ones. Raises KinematicsError if this calculator
+        cannot serve the layout, leaving the previous parameters in place.
+        """
+        if passive_wheels is None:
+            passive_wheels = self.layout.fixed_wheels if self.layout is not None else ()
+        drives = tuple(drives)
+        self._check_layout(drives, tuple(passive_wheels))
+        layout = Layout(drives, passive_wheels)
+        keep = self.layout is not None and len(self.layout.drives) == len(drives)
+        self.layout = layout
+        self._estimator = make_estimator(self.estimator_name, layout, self.seed)
+        if not keep:
+            self._last_steering = [0.0] * len(drives)
+
+    def calculate_command(self, twist: Twist) -> CommandResult:
+        """Joint commands for a body twist; the closest realisable twist if this one is not."""
+        layout = self._require()
+        vals = (float(twist.vx), float(twist.vy), float(twist.wz))
+        if not all(math.isfinite(v) for v in vals):
+            raise KinematicsError(f"twist must be finite, not {twist}")
+        vx, vy, wz = layout.project(*vals)
+        realised = Twist(vx, vy, wz)
+        changed = False
+        if layout.constrained:
+            # Compare by the largest change of a wheel's velocity, so the test has units [m/s].
+            for x, y in zip(layout.x, layout.y):
+                ex = (vals[0] - vx) - (vals[2] - wz) * y
+                ey = (vals[1] - vy) + (vals[2] - wz) * x
+                if math.hypot(ex, ey) > REALISABLE_TOLERANCE:
+                    changed = True
+                    break
+            if not changed:
+                realised = Twist(*vals)
+        commands = self._commands(realised)
+        self._last_steering = [c.steering for c in commands]
+        return CommandResult(tuple(commands), realised if changed else twist, twist, changed)
+
+    def set_zero_speed(self, commands: Sequence[DriveCommand]) -> List[DriveCommand]:
+        """The commands with every wheel speed 0 and the steering kept (command timeout, e-stop)."""
+        return [DriveCommand(c.steering, 0.0) for c in commands]
+
+    def calculate_odometry(self, states: Sequence[DriveState], time: float) -> OdometryResult:
+        """Body velocity from measured drive states, and the pose integrated since the last call.
+
+        time [s] is the time of the states. The first call, a step back in time and a gap longer than
+        MAX_ODOMETRY_DT integrate nothing (dt = 0), as in the original.
+        """
+        layout = self._require()
+        if len(states) != len(layout.drives):
+            raise KinematicsError(f"expected {len(layout.drives)} drive states, got {len(states)}")
+        dt = 0.0 if self._last_time is None else time - self._last_time
+        if not 0.0 < dt <= MAX_ODOMETRY_DT:
+            dt = 0.0
+        self._last_time = time
+        steering = [s.steering for s in states]
+        speed = [s.speed for s in states]
+        vx, vy, wz, res, translating = self._estimator.estimate(steering, speed)
+        twist = Twist(vx, vy, wz)
+        if not all(math.isfinite(v) for v in (vx, vy, wz)):
+            return OdometryResult(twist, self._pose, res, dt, False, translating)
+        self._pose = integrate_se2(self._pose, twist, dt)
+        return OdometryResult(twist, self._pose, res, dt, True, translating)
+
+    def zero_odometry_pose(self) -> None:
+        self._pose = Pose()
+
+    # ---- conveniences ---------------------------------------------------------------------
+    @classmethod
+    def from_config(cls, config, **options) -> "BaseCalculator":
+        """A calculator initialised with a thorvald_model RobotConfig's drives and passive wheels."""
+        calc = cls(**options)
+        calc.initialize(config.drives, config.passive_wheels)
+        return calc
+
+    @property
+    def pose(self) -> Pose:
+        return self._pose
+
+    def set_pose(self, pose: Pose) -> None:
+        self._pose = pose
+
+    def wheel_velocity(self, twist: Twist, index: int):
+        """Velocity (vx, vy) [m/s] the twist gives drive index's wheel contact."""
+        layout = self._require()
+        return twist.vx - twist.wz * layout.y[index], twist.vy + twist.wz * layout.x[index]
+
+    # ---- what a calculator specialises ----------------------------------------------------
+    def _check_layout(self, drives: Sequence, passive_wheels: Sequence) -> None:
+        """Raises KinematicsError naming the problem if this calculator cannot serve the layout."""
+
+    def _commands(self, twist: Twist) -> List[DriveCommand]:
+        """Commands realising a realisable twist: each wheel points along its contact's velocity."""
+        layout = self.layout
+        out = []
+        for k, (x, y) in enumerate(zip(layout.x, layout.y)):
+            wvx = twist.vx - twist.wz * y
+            wvy = twist.vy + twist.wz * x
+            if not layout.steerable[k]:
+                out.append(DriveCommand(0.0, wvx))  # rolls along x; the lateral part is 0 by projection
+                continue
+            speed = math.hypot(wvx, wvy)
+            if speed <= STOPPED_SPEED:
+                # A zero command (or a wheel at the centre of rotation) keeps the wheel's heading
+                # instead of snapping it straight ahead as the original did.
+                out.append(DriveCommand(self._last_steering[k], 0.0))
+            else:
+                out.append(DriveCommand(math.atan2(wvy, wvx), speed))
+        return out
+
+    def _require(self) -> Layout:
+        if self.layout is None:
+            raise KinematicsError(f"{type(self).__name__} used before initialize()")
+        return self.layout

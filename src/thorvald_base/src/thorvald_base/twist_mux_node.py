@@ -1,0 +1,85 @@
+"""The ``twist_mux`` node: relays the highest-priority live Twist input on ``cmd_vel_out``.
+
+Parameters (in twist_mux's format): ``~topics`` and ``~locks``, lists of ``{name, topic, timeout,
+priority}`` (or mappings from name to ``{topic, timeout, priority}``); ``~diagnostics_rate`` [Hz]
+(default 1). Inputs are geometry_msgs/Twist, locks std_msgs/Bool. The state is published as
+diagnostic_msgs/DiagnosticArray on ``/diagnostics``.
+"""
+
+import sys
+
+import rospy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import Twist
+from std_msgs.msg import Bool
+
+from .errors import ThorvaldBaseError
+from .mux import TwistMux, parse_sources
+
+
+class TwistMuxNode:
+    def __init__(self):
+        inputs = parse_sources(rospy.get_param("~topics", None), "~topics")
+        locks = parse_sources(rospy.get_param("~locks", None), "~locks")
+        if not inputs:
+            raise ThorvaldBaseError(
+                "~topics: no input topic configured: give at least one {name, topic, timeout, priority}"
+            )
+        self.mux = TwistMux(inputs, locks)
+        self.pub = rospy.Publisher("cmd_vel_out", Twist, queue_size=1)
+        self.diag_pub = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=1)
+        self.subs = [rospy.Subscriber(s.topic, Twist, self.on_input, s.name, queue_size=1) for s in inputs]
+        self.subs += [rospy.Subscriber(s.topic, Bool, self.on_lock, s.name, queue_size=1) for s in locks]
+        rate = float(rospy.get_param("~diagnostics_rate", 1.0))
+        if rate > 0:
+            self.timer = rospy.Timer(rospy.Duration(1.0 / rate), self.publish_diagnostics)
+        rospy.loginfo(
+            "twist_mux: inputs %s; locks %s",
+            ", ".join(f"{s.name} ({s.topic}, priority {s.priority})" for s in inputs),
+            ", ".join(f"{s.name} ({s.topic}, priority {s.priority})" for s in locks) or "none",
+        )
+
+    def on_input(self, msg, name):
+        if self.mux.on_input(name, rospy.get_time()):
+            self.pub.publish(msg)
+
+    def on_lock(self, msg, name):
+        self.mux.on_lock(name, msg.data, rospy.get_time())
+
+    def publish_diagnostics(self, _event=None):
+        status = self.mux.status(rospy.get_time())
+        diag = DiagnosticStatus(name=rospy.get_name() + ": twist mux", hardware_id="none")
+        selected = status["selected"]
+        diag.level = DiagnosticStatus.OK if selected else DiagnosticStatus.WARN
+        diag.message = f"relaying {selected}" if selected else "no live input"
+        values = [KeyValue("selected", selected or "none"), KeyValue("lock priority", str(status["lock_priority"]))]
+        for s in status["inputs"]:
+            age = "never" if s["age"] is None else f"{s['age']:.2f} s ago"
+            values.append(
+                KeyValue(
+                    f"input {s['name']}",
+                    f"{s['topic']} priority {s['priority']}, last {age}, " + ("masked" if s["masked"] else "live"),
+                )
+            )
+        for s in status["locks"]:
+            age = "never" if s["age"] is None else f"{s['age']:.2f} s ago"
+            values.append(
+                KeyValue(
+                    f"lock {s['name']}",
+                    f"{s['topic']} priority {s['priority']}, last {age}, " + ("locked" if s["locked"] else "open"),
+                )
+            )
+        diag.values = values
+        array = DiagnosticArray(status=[diag])
+        array.header.stamp = rospy.Time.now()
+        self.diag_pub.publish(array)
+
+
+def main():
+    rospy.init_node("twist_mux")
+    try:
+        TwistMuxNode()
+    except ThorvaldBaseError as e:
+        rospy.logfatal("twist_mux: %s", e)
+        sys.exit(1)
+    rospy.spin()
