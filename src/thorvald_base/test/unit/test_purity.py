@@ -1,4 +1,5 @@
-"""The pure core (kinematics, twist_mux logic, configuration loader) imports no rospy, messages or pybullet (checked in a clean interpreter)."""
+"""The pure core (kinematics, twist_mux logic, configuration loader) imports no rospy, messages or
+pybullet (checked in a clean interpreter)."""
 
 import os
 import subprocess
