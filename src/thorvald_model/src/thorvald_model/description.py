@@ -1,0 +1,167 @@
+"""The robot description (URDF) generated from a robot configuration file by xacro (paper 4.1).
+
+``urdf/thorvald_model.xacro`` builds the robot from the configuration; it reads the file with
+xacro's ``load_yaml()``. This module runs the real xacro (the ROS 1 flavour, 1.13) with that one
+symbol replaced, so that loading the robot configuration goes through the shared loader
+(:func:`thorvald_model.config.load_robot_config`): the xacro sees the validated configuration
+with every default filled in and every alias resolved (``RobotConfig.to_dict()``), and a broken
+file stops with the loader's list of problems. The xacro never repeats a default or a rule.
+
+Other YAML files (a user's extras loading their sensor table) load with ``yaml.safe_load``, since
+xacro 1.13's own ``load_yaml`` calls ``yaml.load`` without a Loader, which PyYAML 6 rejects.
+
+Pure: no rospy, no messages. ``$(find pkg)`` in a user's extras resolves through rospack.
+"""
+
+import contextlib
+import functools
+import os
+import re
+from typing import Any, Callable, Dict, Iterator, Optional
+
+import rospkg
+import xacro
+import yaml
+
+from .config import load_robot_config, parse_robot_config
+from .errors import ConfigError, ThorvaldModelError
+
+PACKAGE_DIR = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+XACRO_FILE = os.path.join(PACKAGE_DIR, "urdf", "thorvald_model.xacro")
+
+
+class XacroError(ThorvaldModelError):
+    """xacro failed on something other than the robot configuration (e.g. a broken extras file)."""
+
+
+class RobotConfigAbort(BaseException):
+    """Carries a ConfigError out of xacro.
+
+    xacro catches every ``Exception`` while it evaluates an expression and again in its ``main()``,
+    where it prints its own message and the file stack. A BaseException passes through both, so
+    the caller can report the loader's message alone.
+    """
+
+    def __init__(self, error: ConfigError):
+        super().__init__(str(error))
+        self.error = error
+
+
+def xacro_file() -> str:
+    """Path of thorvald_model.xacro (source or devel space, else through rospack)."""
+    if os.path.isfile(XACRO_FILE):
+        return XACRO_FILE
+    return os.path.join(rospkg.RosPack().get_path("thorvald_model"), "urdf", "thorvald_model.xacro")
+
+
+def _is_robot_config(path: str, data: Any) -> bool:
+    arg = xacro.substitution_args_context.get("arg", {}).get("robot_config")
+    if arg and os.path.realpath(arg) == os.path.realpath(path):
+        return True
+    return isinstance(data, dict) and "motor_drives" in data
+
+
+def _load_yaml(filename: str) -> Any:
+    """xacro's load_yaml(): same path and dependency handling, safe loading, robot files validated."""
+    filename = xacro.abs_filename_spec(filename)
+    oldstack = xacro.push_file(filename)
+    try:
+        with open(filename) as f:
+            data = yaml.safe_load(f)
+        if _is_robot_config(filename, data):
+            try:
+                return parse_robot_config(data, filename).to_dict()
+            except ConfigError as e:
+                raise RobotConfigAbort(e) from None
+        return data
+    except (OSError, yaml.YAMLError) as e:
+        if _is_robot_config(filename, None):
+            try:  # the loader words unreadable and malformed files the same way for every tool
+                load_robot_config(filename)
+            except ConfigError as error:
+                raise RobotConfigAbort(error) from None
+        raise xacro.XacroException(f"cannot load YAML file {filename}: {e}") from None
+    finally:
+        xacro.restore_filestack(oldstack)
+        xacro.all_includes.append(filename)
+
+
+_ARG = re.compile(r"^\$\(arg\s+([^\s()]+)\s*\)$")
+
+
+def _eval_extension(text: str, _original: Callable[[str], Any]) -> Any:
+    """``$(arg name)`` straight from xacro's arguments; anything else (``$(find pkg)``) through
+    roslaunch as xacro does. roslaunch pulls in message modules, which the pure core avoids."""
+    m = _ARG.match(text)
+    args = xacro.substitution_args_context.get("arg") or {}
+    if m and m.group(1) in args:
+        return args[m.group(1)]
+    return _original(text)
+
+
+@contextlib.contextmanager
+def shared_loader() -> Iterator[None]:
+    """Within the block, xacro's load_yaml() is :func:`_load_yaml` and $(arg) needs no roslaunch."""
+    previous_load = xacro.global_symbols.get("load_yaml")
+    previous_extension = xacro.eval_extension
+    xacro.global_symbols["load_yaml"] = _load_yaml
+    xacro.eval_extension = functools.partial(_eval_extension, _original=previous_extension)
+    try:
+        yield
+    finally:
+        xacro.global_symbols["load_yaml"] = previous_load
+        xacro.eval_extension = previous_extension
+
+
+def xacro_args(
+    robot_config: str,
+    tf_prefix: str = "",
+    model_extras: str = "",
+    robot_name: Optional[str] = None,
+    datum_file: str = "",
+) -> Dict[str, str]:
+    """The xacro arguments of thorvald_model.xacro; robot_name defaults to the file's base name."""
+    if robot_name is None:
+        robot_name = os.path.splitext(os.path.basename(robot_config))[0]
+    return {
+        "robot_name": robot_name,
+        "tf_prefix": tf_prefix,
+        "robot_config": os.path.abspath(robot_config),
+        "model_extras": os.path.abspath(model_extras) if model_extras else "",
+        "datum_file": datum_file,
+    }
+
+
+def generate_urdf(
+    robot_config: str,
+    tf_prefix: str = "",
+    model_extras: str = "",
+    robot_name: Optional[str] = None,
+    datum_file: str = "",
+) -> str:
+    """The URDF of the robot described by the configuration file robot_config.
+
+    Raises ConfigError (every problem of the file) or XacroError (e.g. an extras file that is
+    missing or broken).
+    """
+    mappings = xacro_args(robot_config, tf_prefix, model_extras, robot_name, datum_file)
+    try:
+        with shared_loader():
+            doc = xacro.process_file(xacro_file(), mappings=mappings, in_order=True)
+    except RobotConfigAbort as abort:
+        raise abort.error from None
+    except xacro.XacroException as e:
+        raise XacroError(_xacro_message(e)) from None
+    except Exception as e:  # xml.parsers.expat.ExpatError from a malformed extras file, among others
+        raise XacroError(f"{type(e).__name__}: {e}") from None
+    finally:
+        xacro.substitution_args_context["arg"] = {}
+    return doc.toprettyxml(indent="  ")
+
+
+def _xacro_message(e: Exception) -> str:
+    text = str(e)
+    stack = [f for f in xacro.filestack if f]
+    if stack:
+        text += f" (in {stack[-1]})"
+    return text

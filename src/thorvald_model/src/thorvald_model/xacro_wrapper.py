@@ -1,0 +1,68 @@
+"""``rosrun thorvald_model xacro FILE [name:=value ...]``: the real xacro, fit for robot files.
+
+Runs xacro's own ``main()`` (xacro 1.13, the ROS 1 flavour: same options, same output, same
+``$(find pkg)``) after two changes:
+
+1. ``yaml.load`` gets a safe default Loader: xacro 1.13 calls it without one, which PyYAML 6
+   rejects, so any other YAML a user's xacro loads works as it did with PyYAML 5.
+2. xacro's ``load_yaml()`` loads a robot configuration through the shared loader (see
+   :mod:`thorvald_model.description`): a broken file prints the loader's problems, one per line,
+   and exits 2, without xacro's traceback or file stack.
+
+xacro evaluates the ``<robot name="$(arg robot_name)">`` attribute before the ``<xacro:arg>``
+elements inside it, so an absent ``robot_name:=`` gets the robot file's base name here, as
+:func:`thorvald_model.description.generate_urdf` does.
+
+Launch files call it by name (``command="rosrun thorvald_model xacro ..."``): the PyPI xacro is
+not a ROS package, so ``$(find xacro)/xacro`` does not exist here.
+"""
+
+import functools
+import os
+import sys
+from typing import List, Optional
+
+import xacro
+import yaml
+
+from .description import RobotConfigAbort, shared_loader
+
+
+def _safe_default_loader() -> None:
+    if getattr(yaml.load, "_thorvald_safe_default", False):
+        return
+    original = yaml.load
+
+    @functools.wraps(original)
+    def load(stream, Loader=None, **kwargs):
+        return original(stream, Loader=Loader or yaml.SafeLoader, **kwargs)
+
+    load._thorvald_safe_default = True
+    yaml.load = load
+
+
+def _with_robot_name(argv: List[str]) -> List[str]:
+    names = [a.split(":=", 1)[0] for a in argv if ":=" in a and not a.startswith("_")]
+    if "robot_name" in names:
+        return argv
+    configs = [a.split(":=", 1)[1] for a in argv if a.startswith("robot_config:=")]
+    name = os.path.splitext(os.path.basename(configs[-1]))[0] if configs and configs[-1] else "thorvald_ii"
+    return [*argv, "robot_name:=" + name]
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    if argv is not None:
+        sys.argv = [sys.argv[0], *argv]
+    sys.argv = _with_robot_name(sys.argv)
+    _safe_default_loader()
+    try:
+        with shared_loader():
+            xacro.main()  # exits 2 itself on xacro's own errors
+    except RobotConfigAbort as abort:
+        print(abort.error, file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
