@@ -6,7 +6,7 @@ setup:
 	@tools/setup
 
 demo: setup
-	@tools/demo
+	@tools/demo $(ROBOT)
 
 test: setup
 	@tools/run-tests

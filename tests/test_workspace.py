@@ -22,7 +22,7 @@ def test_setup_rerun_has_nothing_to_do():
     assert "built (6 packages)" in proc.stdout
 
 
-def test_main_job_checks_every_example_robot():
+def test_main_job_checks_every_example_robot_and_drives_the_verification_manoeuvre():
     proc = run(["tools/demo"])
     assert proc.returncode == 0, proc.stdout + proc.stderr
     rows = [line.split() for line in proc.stdout.splitlines() if line.startswith("thorvald_ii_")]
@@ -36,3 +36,17 @@ def test_main_job_checks_every_example_robot():
     assert by_name["thorvald_ii_2wd_diff"][1:5] == ["2", "0", "2", "2"]
     assert by_name["thorvald_ii_1wd1ws_rwd"][1:5] == ["1", "1", "1", "2"]
     assert by_name["thorvald_ii_1wd1ws_fwd"][-1] == "pltf_clc_1wd::PltfClc1WD"
+
+    report = dict(
+        line.strip().split("  ", 1)
+        for line in proc.stdout.splitlines()
+        if line.startswith("  ") and "  " in line.strip()
+    )
+    by_command = float(report["distance by command"].split()[0])
+    by_odometry = float(report["distance by odometry"].split()[0])
+    difference = float(report["end-point difference"].split()[0])
+    # the plan: 4 legs of 10 m and two 20 m circles at 1 m/s
+    assert by_command == 80.0
+    # the simulated drives lag the commands (ramps, steering slew), but only a little
+    assert abs(by_odometry - by_command) < 1.0
+    assert difference < 0.5

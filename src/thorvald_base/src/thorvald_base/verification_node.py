@@ -1,0 +1,106 @@
+"""The ``verification_drive`` node: drives the paper's verification manoeuvre on simulated time.
+
+It owns the simulated clock: it publishes ``/clock`` (so run it with ``/use_sim_time`` true),
+``~speedup`` times faster than real time, publishes the planned twists on ``cmd_vel`` (remap it to
+an input of twist_mux, e.g. ``nav_vel``), records ``odometry/base_raw`` and prints the report.
+
+Parameters: ``~robot_model`` (the robot's YAML, for the plan and the report), ``~speedup``
+(default 5), ``~clock_step`` [s] of simulated time per /clock message (default 0.005),
+``~command_rate`` [Hz] (default 20), ``~startup_timeout`` [s] of wall time (default 30).
+"""
+
+import os
+import sys
+import time
+
+import rospy
+from geometry_msgs.msg import Twist as TwistMsg
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+
+from thorvald_model import ConfigError, load_robot_config
+
+from .verification import duration, plan_for, report, twist_at
+
+
+class VerificationDrive:
+    def __init__(self):
+        path = rospy.get_param("~robot_model")
+        self.config = load_robot_config(path)
+        self.name = os.path.splitext(os.path.basename(path))[0]
+        self.speedup = float(rospy.get_param("~speedup", 5.0))
+        self.step = float(rospy.get_param("~clock_step", 0.005))
+        self.command_period = 1.0 / float(rospy.get_param("~command_rate", 20.0))
+        self.startup_timeout = float(rospy.get_param("~startup_timeout", 30.0))
+        self.description, self.plan = plan_for(self.config)
+        self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10)
+        self.cmd_pub = rospy.Publisher("cmd_vel", TwistMsg, queue_size=10)
+        self.points = []
+        self.recording = False
+        self.odom_seen = False
+        rospy.Subscriber("odometry/base_raw", Odometry, self.on_odometry, queue_size=100)
+        self.sim_time = 1.0
+
+    def on_odometry(self, msg):
+        self.odom_seen = True
+        if self.recording:
+            p = msg.pose.pose.position
+            self.points.append((p.x, p.y))
+
+    def tick(self):
+        self.sim_time += self.step
+        self.clock_pub.publish(Clock(rospy.Time.from_sec(self.sim_time)))
+        time.sleep(self.step / self.speedup)
+
+    def run(self):
+        # Let time run until base_driver publishes odometry and twist_mux listens to our commands.
+        deadline = time.time() + self.startup_timeout
+        while not (self.odom_seen and self.cmd_pub.get_num_connections() > 0):
+            if time.time() > deadline or rospy.is_shutdown():
+                raise RuntimeError("base_driver or twist_mux did not come up (no odometry/base_raw or no mux input)")
+            self.tick()
+        for _ in range(int(1.0 / self.step)):  # one simulated second standing still
+            self.tick()
+        self.points = []
+        self.recording = True
+        start_sim, start_wall = self.sim_time, time.time()
+        next_command = start_sim
+        total = duration(self.plan)
+        while not rospy.is_shutdown():
+            t = self.sim_time - start_sim
+            twist = twist_at(self.plan, t)
+            if twist is None:
+                break
+            if self.sim_time >= next_command:
+                msg = TwistMsg()
+                msg.linear.x, msg.linear.y, msg.angular.z = twist.vx, twist.vy, twist.wz
+                self.cmd_pub.publish(msg)
+                next_command += self.command_period
+            self.tick()
+        for _ in range(int(1.0 / self.step)):  # let the robot come to rest
+            self.tick()
+        self.recording = False
+        return report(
+            self.name,
+            self.config,
+            self.description,
+            self.plan,
+            self.points,
+            sim_time=total,
+            wall=time.time() - start_wall,
+        )
+
+
+def main():
+    rospy.init_node("verification_drive")
+    try:
+        drive = VerificationDrive()
+        text = drive.run()
+    except ConfigError as e:
+        rospy.logfatal("verification_drive: %s", e)
+        sys.exit(2)
+    except (RuntimeError, KeyError) as e:
+        rospy.logfatal("verification_drive: %s", e)
+        sys.exit(1)
+    print(text, flush=True)
+    rospy.signal_shutdown("verification drive done")
