@@ -53,22 +53,11 @@ class TwistMuxNode:
         diag.level = DiagnosticStatus.OK if selected else DiagnosticStatus.WARN
         diag.message = f"relaying {selected}" if selected else "no live input"
         values = [KeyValue("selected", selected or "none"), KeyValue("lock priority", str(status["lock_priority"]))]
-        for s in status["inputs"]:
-            age = "never" if s["age"] is None else f"{s['age']:.2f} s ago"
-            values.append(
-                KeyValue(
-                    f"input {s['name']}",
-                    f"{s['topic']} priority {s['priority']}, last {age}, " + ("masked" if s["masked"] else "live"),
-                )
-            )
-        for s in status["locks"]:
-            age = "never" if s["age"] is None else f"{s['age']:.2f} s ago"
-            values.append(
-                KeyValue(
-                    f"lock {s['name']}",
-                    f"{s['topic']} priority {s['priority']}, last {age}, " + ("locked" if s["locked"] else "open"),
-                )
-            )
+        for kind, key, words in (("input", "masked", ("live", "masked")), ("lock", "locked", ("open", "locked"))):
+            for s in status[kind + "s"]:
+                age = "never" if s["age"] is None else f"{s['age']:.2f} s ago"
+                text = f"{s['topic']} priority {s['priority']}, last {age}, {words[bool(s[key])]}"
+                values.append(KeyValue(f"{kind} {s['name']}", text))
         diag.values = values
         array = DiagnosticArray(status=[diag])
         array.header.stamp = rospy.Time.now()
