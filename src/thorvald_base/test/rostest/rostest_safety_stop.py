@@ -1,0 +1,94 @@
+#!/usr/bin/env python3
+"""base_driver: ~safety_stop true holds the wheels at 0 (steering still commanded) until released."""
+
+import math
+import time
+import unittest
+
+import rospy
+import rostest
+from driver_testing import (
+    STARTUP_TIMEOUT,
+    WAIT,
+    CommandStream,
+    Topic,
+    commands_are,
+    describe,
+    drives_from_params,
+    expected_commands,
+    twist,
+)
+from std_srvs.srv import SetBool
+
+from thorvald_msgs.msg import BaseState
+
+HOLD = 1.2  # [s]: longer than the 0.5 s command timeout, while commands keep arriving
+
+
+class SafetyStopTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.commands = Topic("joint_commands", BaseState)
+        cls.states = Topic("base_state", BaseState)
+        cls.cmd = CommandStream("twist_mux/cmd_vel")
+        assert cls.cmd.wait_for_subscriber(), "base_driver did not subscribe to twist_mux/cmd_vel"
+        assert cls.commands.wait_for(timeout=STARTUP_TIMEOUT, since=0), "no joint_commands from base_driver"
+        rospy.wait_for_service("base_driver/safety_stop", timeout=STARTUP_TIMEOUT)
+        cls.safety_stop = rospy.ServiceProxy("base_driver/safety_stop", SetBool)
+        cls.drives = drives_from_params()
+
+    def tearDown(self):
+        self.safety_stop(False)
+        self.cmd.stop()
+
+    def test_wheels_held_while_enabled_and_resume_when_disabled(self):
+        # vx = vy = 0.3: every wheel steers 45 degrees and rolls at 0.3 * sqrt(2) = 0.424 m/s
+        expected = expected_commands(self.drives, 0.3, 0.3, 0.0)
+        held = [(math.pi / 4, 0.0)] * len(self.drives)
+        self.assertAlmostEqual(expected[0][0], math.pi / 4)
+        self.cmd.send(twist(0.3, 0.3, 0.0))
+        self.assertIsNotNone(self.commands.wait_for(lambda m: commands_are(m, expected), timeout=WAIT))
+
+        response = self.safety_stop(True)
+        self.assertTrue(response.success)
+        self.assertEqual(response.message, "safety stop enabled")
+        first = self.commands.wait_for(lambda m: commands_are(m, held), timeout=WAIT)
+        self.assertIsNotNone(first, "the wheels were not stopped: " + describe(self.commands.latest()))
+        # held while the command keeps streaming; the measured wheels ramp down to 0 (1.5 m/s^2)
+        start = time.time()
+        time.sleep(HOLD)
+        during = self.commands.since(start)
+        self.assertGreater(len(during), 10)
+        for m in during:
+            self.assertTrue(commands_are(m, held), describe(m))
+        state = self.states.latest()
+        for v, a in zip(state.prop_speed, state.steer_pos):
+            self.assertAlmostEqual(v, 0.0, places=9)
+            self.assertAlmostEqual(a, math.pi / 4, places=3)
+
+        response = self.safety_stop(False)
+        self.assertTrue(response.success)
+        self.assertEqual(response.message, "safety stop disabled")
+        self.assertIsNotNone(
+            self.commands.wait_for(lambda m: commands_are(m, expected), timeout=WAIT),
+            "the wheels did not resume: " + describe(self.commands.latest()),
+        )
+        self.assertIsNotNone(self.states.wait_for(lambda m: commands_are(m, expected, tol=1e-3), timeout=WAIT))
+
+    def test_enabled_without_a_command_holds_a_later_command(self):
+        self.assertTrue(self.safety_stop(True).success)
+        self.cmd.send(twist(0.5))
+        start = time.time()
+        time.sleep(0.6)
+        during = self.commands.since(start)
+        self.assertGreater(len(during), 5)
+        for m in during:
+            self.assertTrue(all(v == 0.0 for v in m.prop_speed), describe(m))
+        self.assertTrue(self.safety_stop(False).success)
+        expected = [(0.0, 0.5)] * len(self.drives)
+        self.assertIsNotNone(self.commands.wait_for(lambda m: commands_are(m, expected), timeout=WAIT))
+
+
+if __name__ == "__main__":
+    rospy.init_node("safety_stop_test")
+    rostest.rosrun("thorvald_base", "base_driver_safety_stop", SafetyStopTest)
