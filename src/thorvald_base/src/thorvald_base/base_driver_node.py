@@ -68,8 +68,10 @@ MOVING = 0.005  # [m/s], [rad/s]: faster than this, the pose covariance grows (t
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
 
 
-def quaternion_z(yaw):
-    return 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
+def set_yaw(quaternion, yaw):
+    """Fills a geometry_msgs/Quaternion with a rotation of yaw [rad] about z."""
+    quaternion.x, quaternion.y = 0.0, 0.0
+    quaternion.z, quaternion.w = math.sin(yaw / 2.0), math.cos(yaw / 2.0)
 
 
 class BaseDriverNode:
@@ -230,14 +232,8 @@ class BaseDriverNode:
         msg.header.stamp = stamp
         msg.header.frame_id = self.odom_frame
         msg.child_frame_id = self.base_frame
-        q = quaternion_z(p.yaw)
         msg.pose.pose.position.x, msg.pose.pose.position.y = p.x, p.y
-        (
-            msg.pose.pose.orientation.x,
-            msg.pose.pose.orientation.y,
-            msg.pose.pose.orientation.z,
-            msg.pose.pose.orientation.w,
-        ) = q
+        set_yaw(msg.pose.pose.orientation, p.yaw)
         msg.pose.covariance = self.pose_cov
         msg.twist.twist.linear.x, msg.twist.twist.linear.y, msg.twist.twist.angular.z = t.vx, t.vy, t.wz
         msg.twist.covariance = self.twist_cov
@@ -247,12 +243,7 @@ class BaseDriverNode:
             tf.header = msg.header
             tf.child_frame_id = self.base_frame
             tf.transform.translation.x, tf.transform.translation.y = p.x, p.y
-            (
-                tf.transform.rotation.x,
-                tf.transform.rotation.y,
-                tf.transform.rotation.z,
-                tf.transform.rotation.w,
-            ) = q
+            set_yaw(tf.transform.rotation, p.yaw)
             self.tf.sendTransform(tf)
 
     def publish_status(self, time, stamp):
