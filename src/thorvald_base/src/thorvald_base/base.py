@@ -20,11 +20,8 @@ from thorvald_model.config import RobotConfig
 from .errors import ThorvaldBaseError
 from .kinematics import BaseCalculator, DriveCommand, DriveLayer, DriveState, OdometryResult, SimulatedDrive, Twist
 
-# Mode codes of BaseState.drive_mode and Controller.controller_mode (thorvald_msgs/BaseState).
-MODE_DRIVE = 0
-MODE_HOME = 1
+# Mode codes of Controller.controller_mode (the MODE_* values of thorvald_msgs/BaseState).
 MODE_ONLINE = 3
-MODE_LOST_CONNECTION = 4
 
 # A command is absurd, and refused, beyond this multiple of what the fastest wheel can do.
 ABSURD_FACTOR = 10.0

@@ -15,7 +15,7 @@ Pure Python: the node converts messages and clock readings to these calls.
 """
 
 from dataclasses import dataclass
-from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence
+from typing import Any, Dict, List, Mapping, Optional, Sequence
 
 from .errors import ParameterError
 
@@ -150,7 +150,3 @@ class TwistMux:
                 for s in self.locks.values()
             ],
         }
-
-
-def topics_of(sources: Iterable[Source]) -> List[str]:
-    return [s.topic for s in sources]

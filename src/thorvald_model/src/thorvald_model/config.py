@@ -840,11 +840,6 @@ def _reach(wheel) -> float:
     return reach
 
 
-def drive_field_names() -> Tuple[str, ...]:
-    """Keys base_driver's set_drive_params may change (the drive dataclass fields of the file)."""
-    return tuple(k.name for k in DRIVE_KEYS)
-
-
 __all__ = [
     "DIFF_CALCULATOR",
     "DRIVE_DIFF",
