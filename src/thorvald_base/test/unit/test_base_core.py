@@ -3,7 +3,7 @@
 import math
 
 import pytest
-from conftest import EXAMPLE_ROBOTS, four_ws
+from base_test_helpers import EXAMPLE_ROBOTS, four_ws
 
 from thorvald_base.base import BaseDriverCore, SimulatedBase
 from thorvald_base.kinematics import PltfClcStd

@@ -3,7 +3,7 @@
 import math
 
 import pytest
-from conftest import diff, drive, four_wd_two_ws, four_ws, one_wheel
+from base_test_helpers import diff, drive, four_wd_two_ws, four_ws, one_wheel
 
 from thorvald_base.errors import KinematicsError
 from thorvald_base.kinematics import DriveState, PltfClc1WD, PltfClc2WDiff, PltfClcStd, Twist

@@ -3,7 +3,7 @@
 import math
 
 import pytest
-from conftest import four_ws
+from base_test_helpers import four_ws
 from hypothesis import given, settings
 from hypothesis import strategies as st
 

@@ -4,7 +4,7 @@ import math
 import random
 
 import pytest
-from conftest import four_ws, ring
+from base_test_helpers import four_ws, ring
 
 from thorvald_base.kinematics import DriveState, PltfClcStd, Pose, Twist, integrate_se2
 

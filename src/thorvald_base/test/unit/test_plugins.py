@@ -7,7 +7,7 @@ import textwrap
 
 import pytest
 import rospkg
-from conftest import WORKSPACE_SRC, four_ws
+from base_test_helpers import WORKSPACE_SRC, four_ws
 
 from thorvald_base.errors import (
     PluginDescriptionError,

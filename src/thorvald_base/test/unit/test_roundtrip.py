@@ -3,7 +3,7 @@
 import math
 
 import pytest
-from conftest import ROBOT_IDS, make_realisable, robot_config
+from base_test_helpers import ROBOT_IDS, make_realisable, robot_config
 from hypothesis import given, settings
 from hypothesis import strategies as st
 

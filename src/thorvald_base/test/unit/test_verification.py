@@ -4,7 +4,7 @@ import math
 import os
 
 import pytest
-from conftest import EXAMPLE_ROBOTS
+from base_test_helpers import EXAMPLE_ROBOTS
 
 from thorvald_base.plugins import load_calculator
 from thorvald_base.verification import commanded_path, duration, plan_for, report

@@ -5,7 +5,7 @@ import subprocess
 
 import pytest
 import yaml
-from conftest import EXAMPLE_ROBOTS, FIGURE5, four_drives
+from model_test_helpers import EXAMPLE_ROBOTS, FIGURE5, four_drives
 
 from thorvald_model.check_config import main
 

@@ -5,7 +5,7 @@ import os
 
 import pytest
 import yaml
-from conftest import EXAMPLE_ROBOTS, FIGURE5, std_drive
+from model_test_helpers import EXAMPLE_ROBOTS, FIGURE5, std_drive
 
 from thorvald_model import ConfigError, load_robot_config, parse_robot_config
 from thorvald_model.config import STD_CALCULATOR

@@ -27,7 +27,10 @@ DEFAULT_ESTIMATOR = "lsq"
 # original's exact tan(a_i) == tan(a_j) test, made robust to rounding. A larger value would make
 # the estimator inexact for arcs of radius above about wheelbase / tolerance.
 PARALLEL_TOLERANCE = 1e-6
-AT_ICR = 1e-9  # [m]: a wheel this close to the centre of rotation says nothing about wz
+# [m]: a wheel this close to the centre of rotation says nothing about wz: its rate d x v / d^2 divides
+# two tiny numbers, so rounding in the averaged centre (1e-9 m and less) would swamp it (the centre
+# drive of the 9WD9WS robot when spinning in place).
+AT_ICR = 1e-3
 
 
 def residual(layout: Layout, twist: Tuple[float, float, float], wvx: Sequence[float], wvy: Sequence[float]) -> float:
