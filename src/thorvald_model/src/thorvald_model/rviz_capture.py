@@ -112,7 +112,9 @@ def xvfb(width: int, height: int) -> Iterator[str]:
     """A virtual X display of width x height; yields its name, e.g. ':140'."""
     n = free_display()
     proc = subprocess.Popen(
-        ["Xvfb", f":{n}", "-screen", "0", f"{width}x{height}x24", "-nolisten", "tcp"],
+        # -noreset: by default Xvfb resets when its last client leaves, and refuses connections
+        # meanwhile, so an RViz started right after another one failed to open the display.
+        ["Xvfb", f":{n}", "-screen", "0", f"{width}x{height}x24", "-nolisten", "tcp", "-noreset"],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
         start_new_session=True,

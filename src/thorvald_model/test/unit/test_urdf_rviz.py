@@ -3,10 +3,8 @@ empty scene of the same RViz configuration. Starts its own master (roslaunch) on
 Xvfb on a free display; both stop when the test ends. About 20-30 s."""
 
 import os
-import shutil
 
 import numpy as np
-import pytest
 from urdf_helpers import PKG
 
 from thorvald_model import load_robot_config
@@ -17,10 +15,6 @@ from thorvald_model.rviz_capture import (
     wait_for_render,
     write_rviz_config,
     xvfb,
-)
-
-pytestmark = pytest.mark.skipif(
-    not all(shutil.which(t) for t in ("Xvfb", "roslaunch", "rviz")), reason="needs Xvfb, roslaunch and rviz"
 )
 
 STD = os.path.join(PKG, "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
