@@ -223,8 +223,6 @@ def test_tower_and_pipes_of_the_standard_frame():
 
 def test_type1_drives_cannot_steer():
     tall = os.path.join(PKG, "config", "thorvald_ii_4wd2ws_tall", "thorvald_ii_4wd2ws_tall.yaml")
-    if not os.path.exists(tall):
-        pytest.skip("example robot not there")
     js = joints(urdf_tree(tall))
     assert js["steering2"].get("type") == "fixed" and js["steering3"].get("type") == "fixed"
     assert js["steering0"].get("type") == "revolute"
