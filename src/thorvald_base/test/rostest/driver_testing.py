@@ -29,6 +29,7 @@ class Topic:
     """Records every message of a topic with its wall-clock receive time [s]."""
 
     def __init__(self, name, msg_type, queue_size=200):
+        self.name = name
         self._lock = threading.Lock()
         self._messages = []
         self.sub = rospy.Subscriber(name, msg_type, self._on_message, queue_size=queue_size)
@@ -105,6 +106,21 @@ class CommandStream:
         while time.time() < deadline and not self.pub.get_num_connections():
             time.sleep(0.05)
         return self.pub.get_num_connections() > 0
+
+
+def driver_stream(first):
+    """The command stream into base_driver (twist_mux/cmd_vel), once base_driver subscribes to it and
+    has published on first (a Topic)."""
+    cmd = CommandStream("twist_mux/cmd_vel")
+    assert cmd.wait_for_subscriber(), "base_driver did not subscribe to twist_mux/cmd_vel"
+    assert first.wait_for(timeout=STARTUP_TIMEOUT, since=0), f"no {first.name} from base_driver"
+    return cmd
+
+
+def driver_service(name, srv_type):
+    """A proxy of base_driver's service name, once it is advertised."""
+    rospy.wait_for_service("base_driver/" + name, timeout=STARTUP_TIMEOUT)
+    return rospy.ServiceProxy("base_driver/" + name, srv_type)
 
 
 def drives_from_params(driver="base_driver"):

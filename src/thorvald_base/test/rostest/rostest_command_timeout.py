@@ -13,12 +13,11 @@ import unittest
 import rospy
 import rostest
 from driver_testing import (
-    STARTUP_TIMEOUT,
     WAIT,
-    CommandStream,
     Topic,
     commands_are,
     describe,
+    driver_stream,
     drives_from_params,
     expected_commands,
     twist,
@@ -40,9 +39,7 @@ class CommandTimeoutTest(unittest.TestCase):
     def setUpClass(cls):
         cls.commands = Topic("joint_commands", BaseState)
         cls.states = Topic("base_state", BaseState)
-        cls.cmd = CommandStream("twist_mux/cmd_vel")
-        assert cls.cmd.wait_for_subscriber(), "base_driver did not subscribe to twist_mux/cmd_vel"
-        assert cls.commands.wait_for(timeout=STARTUP_TIMEOUT, since=0), "no joint_commands from base_driver"
+        cls.cmd = driver_stream(cls.commands)
         cls.drives = drives_from_params()
 
     def test_wheels_stop_and_steering_stays_after_the_timeout(self):

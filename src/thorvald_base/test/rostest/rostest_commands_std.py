@@ -13,13 +13,12 @@ import unittest
 import rospy
 import rostest
 from driver_testing import (
-    STARTUP_TIMEOUT,
     WAIT,
-    CommandStream,
     Topic,
     commands_are,
     contact_velocity,
     describe,
+    driver_stream,
     drives_from_params,
     expected_commands,
     max_wheel_speed,
@@ -33,9 +32,7 @@ class CommandsStdTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.commands = Topic("joint_commands", BaseState)
-        cls.cmd = CommandStream("twist_mux/cmd_vel")
-        assert cls.cmd.wait_for_subscriber(), "base_driver did not subscribe to twist_mux/cmd_vel"
-        assert cls.commands.wait_for(timeout=STARTUP_TIMEOUT, since=0), "no joint_commands from base_driver"
+        cls.cmd = driver_stream(cls.commands)
         cls.drives = drives_from_params()
 
     def tearDown(self):

@@ -11,7 +11,7 @@ import unittest
 
 import rospy
 import rostest
-from driver_testing import STARTUP_TIMEOUT, WAIT, CommandStream, Topic, describe, drives_from_params, speeds_are, twist
+from driver_testing import WAIT, Topic, describe, driver_service, driver_stream, drives_from_params, speeds_are, twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 
@@ -35,11 +35,8 @@ class DriveParamsTest(unittest.TestCase):
         cls.commands = Topic("joint_commands", BaseState)
         cls.joints = Topic("base_driver/joint_states", JointState)
         cls.odom = Topic("odometry/base_raw", Odometry)
-        cls.cmd = CommandStream("twist_mux/cmd_vel")
-        assert cls.cmd.wait_for_subscriber(), "base_driver did not subscribe to twist_mux/cmd_vel"
-        assert cls.joints.wait_for(timeout=STARTUP_TIMEOUT, since=0), "no joint_states from base_driver"
-        rospy.wait_for_service("base_driver/set_drive_params", timeout=STARTUP_TIMEOUT)
-        cls.set_params = rospy.ServiceProxy("base_driver/set_drive_params", DriveParams)
+        cls.cmd = driver_stream(cls.joints)
+        cls.set_params = driver_service("set_drive_params", DriveParams)
         cls.drives = drives_from_params()
         cls.cmd.send(twist(SPEED))
         # at speed: the simulated wheels ramp at 1.5 m/s^2

@@ -13,7 +13,7 @@ import unittest
 
 import rospy
 import rostest
-from driver_testing import STARTUP_TIMEOUT, CommandStream, Topic, twist, yaw_of
+from driver_testing import Topic, driver_stream, twist, yaw_of
 from nav_msgs.msg import Odometry
 
 VX, WZ = 0.5, 0.5  # [m/s], [rad/s]
@@ -31,9 +31,7 @@ class OdomCircleTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.odom = Topic("odometry/base_raw", Odometry)
-        cls.cmd = CommandStream("twist_mux/cmd_vel")
-        assert cls.cmd.wait_for_subscriber(), "base_driver did not subscribe to twist_mux/cmd_vel"
-        assert cls.odom.wait_for(timeout=STARTUP_TIMEOUT, since=0), "no odometry/base_raw from base_driver"
+        cls.cmd = driver_stream(cls.odom)
 
     def test_pose_lies_on_the_circle_with_the_tangent_heading(self):
         start = self.odom.latest().pose.pose

@@ -11,7 +11,7 @@ import unittest
 
 import rospy
 import rostest
-from driver_testing import STARTUP_TIMEOUT, WAIT, CommandStream, Topic, twist, yaw_of
+from driver_testing import WAIT, Topic, driver_service, driver_stream, twist, yaw_of
 from nav_msgs.msg import Odometry
 from std_srvs.srv import Trigger
 
@@ -27,11 +27,8 @@ class OdomResetTest(unittest.TestCase):
     def setUpClass(cls):
         cls.odom = Topic("odometry/base_raw", Odometry)
         cls.states = Topic("base_state", BaseState)
-        cls.cmd = CommandStream("twist_mux/cmd_vel")
-        assert cls.cmd.wait_for_subscriber(), "base_driver did not subscribe to twist_mux/cmd_vel"
-        assert cls.odom.wait_for(timeout=STARTUP_TIMEOUT, since=0), "no odometry/base_raw from base_driver"
-        rospy.wait_for_service("base_driver/reset_base_odom", timeout=STARTUP_TIMEOUT)
-        cls.reset = rospy.ServiceProxy("base_driver/reset_base_odom", Trigger)
+        cls.cmd = driver_stream(cls.odom)
+        cls.reset = driver_service("reset_base_odom", Trigger)
 
     def drive_until(self, vx, wz, predicate):
         self.cmd.send(twist(vx, 0.0, wz))

@@ -14,11 +14,10 @@ import unittest
 import rospy
 import rostest
 from driver_testing import (
-    STARTUP_TIMEOUT,
     WAIT,
-    CommandStream,
     Topic,
     describe,
+    driver_stream,
     drives_from_params,
     speeds_are,
     twist,
@@ -42,9 +41,7 @@ class RefusedCommandsTest(unittest.TestCase):
     def setUpClass(cls):
         cls.commands = Topic("joint_commands", BaseState)
         cls.rosout = Topic("/rosout", Log, queue_size=1000)
-        cls.cmd = CommandStream("twist_mux/cmd_vel")
-        assert cls.cmd.wait_for_subscriber(), "base_driver did not subscribe to twist_mux/cmd_vel"
-        assert cls.commands.wait_for(timeout=STARTUP_TIMEOUT, since=0), "no joint_commands from base_driver"
+        cls.cmd = driver_stream(cls.commands)
         cls.drives = drives_from_params()
 
     def tearDown(self):

@@ -8,12 +8,12 @@ import unittest
 import rospy
 import rostest
 from driver_testing import (
-    STARTUP_TIMEOUT,
     WAIT,
-    CommandStream,
     Topic,
     commands_are,
     describe,
+    driver_service,
+    driver_stream,
     drives_from_params,
     expected_commands,
     twist,
@@ -30,11 +30,8 @@ class SafetyStopTest(unittest.TestCase):
     def setUpClass(cls):
         cls.commands = Topic("joint_commands", BaseState)
         cls.states = Topic("base_state", BaseState)
-        cls.cmd = CommandStream("twist_mux/cmd_vel")
-        assert cls.cmd.wait_for_subscriber(), "base_driver did not subscribe to twist_mux/cmd_vel"
-        assert cls.commands.wait_for(timeout=STARTUP_TIMEOUT, since=0), "no joint_commands from base_driver"
-        rospy.wait_for_service("base_driver/safety_stop", timeout=STARTUP_TIMEOUT)
-        cls.safety_stop = rospy.ServiceProxy("base_driver/safety_stop", SetBool)
+        cls.cmd = driver_stream(cls.commands)
+        cls.safety_stop = driver_service("safety_stop", SetBool)
         cls.drives = drives_from_params()
 
     def tearDown(self):
