@@ -15,6 +15,7 @@ from the robot's YAML by base_bringup.launch, and the node's own:
 ``~command_timeout``           a command older than this stops the wheels [s] (default 0.5)
 ``~twist_covariance``          36 values; default diagonal 0.001 x 5, 0.03 for the yaw rate
 ``~estimator``                 odometry: ``lsq`` (default) or ``paper``
+``~projection``                unrealisable twists on a fixed axle: ``axle`` (default) or ``lsq``
 ``~can_interface_type/name``   the CAN line of a real base
 =============================  ===============================================================
 """
@@ -57,6 +58,7 @@ NODE_PARAMS = (
     "command_timeout",
     "twist_covariance",
     "estimator",
+    "projection",
     "can_interface_type",
     "can_interface_name",
     "joint_states_remap_to",
@@ -97,7 +99,11 @@ class BaseDriverNode:
                 "~simple_sim: false: the CAN base is not available yet; set simple_sim:=true to simulate the drives"
             )
         handle = SimulatedBase(self.config)
-        calculator = load_calculator(self.config, estimator=str(params.get("estimator", "lsq")))
+        calculator = load_calculator(
+            self.config,
+            estimator=str(params.get("estimator", "lsq")),
+            projection=str(params.get("projection", "axle")),
+        )
         self.core = BaseDriverCore(
             self.config, calculator, handle, command_timeout=float(params.get("command_timeout", 0.5))
         )

@@ -19,9 +19,9 @@ from .kinematics import DriveLayer, DriveState, Twist
 from .plugins import load_calculator
 
 
-def compute(config, twist: Twist, estimator: str = "lsq", seed: Optional[int] = 0) -> dict:
+def compute(config, twist: Twist, estimator: str = "lsq", seed: Optional[int] = 0, projection: str = "axle") -> dict:
     """The report as plain data (pure: no printing)."""
-    calc = load_calculator(config, estimator=estimator, seed=seed)
+    calc = load_calculator(config, estimator=estimator, seed=seed, projection=projection)
     result = calc.calculate_command(twist)
     layer = DriveLayer(config.drives)
     out = layer.apply(result.commands, [0.0] * len(config.drives))
@@ -49,6 +49,7 @@ def compute(config, twist: Twist, estimator: str = "lsq", seed: Optional[int] = 
         "config": config.source,
         "base_calculator": config.base_calculator,
         "estimator": estimator,
+        "projection": projection,
         "requested": tw(result.requested),
         "commanded": tw(result.twist),
         "changed": result.changed,
@@ -115,10 +116,17 @@ def main(argv: Optional[List[str]] = None) -> int:
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--estimator", choices=("lsq", "paper"), default="lsq", help="odometry estimator (default lsq)")
+    parser.add_argument(
+        "--projection",
+        choices=("axle", "lsq"),
+        default="axle",
+        help="how a twist the wheels cannot realise is changed: keep wz and the speed along a fixed axle "
+        "(axle, default) or the closest wheel velocities (lsq)",
+    )
     args = parser.parse_args(argv)
     try:
         config = load_robot_config(args.config)
-        report = compute(config, Twist(*args.twist), args.estimator)
+        report = compute(config, Twist(*args.twist), args.estimator, projection=args.projection)
     except ConfigError as e:
         print(f"kinematics: {e}", file=sys.stderr)
         return 2

@@ -31,7 +31,7 @@ class Segment:
 
 def plan_for(config: RobotConfig) -> Tuple[str, List[Segment]]:
     """(description, segments) of the manoeuvre this robot can drive."""
-    axle, _ = common_axle(config)
+    axle, _ = common_axle(config.drives, config.passive_wheels)
     if axle is None:
         return "translation in x and y, and rotation about z", _omnidirectional()
     return "a stadium twice: straights and half circles about its axle line", _stadium(axle)

@@ -76,12 +76,14 @@ def test_diff_drive_wheel_speeds_and_sideways_command():
     assert [c.speed for c in r.commands] == pytest.approx([0.5, 0.5])
 
 
-def test_one_wheel_drive_sideways_becomes_rotation_about_the_axle():
+def test_one_wheel_drive_sideways_with_the_lsq_projection_becomes_rotation_about_the_axle():
     # Drive at (L, 0) = (0.8, 0), fixed wheels at (0, +-0.4): realisable twists have vy = 0.
     # Requested (0, 1, 0): minimise over (vx, wz) the squared differences of wheel velocities
     # (drive: (vx, 0.8 wz) vs (0, 1); fixed: (vx -+ 0.4 wz, 0) vs (0, 1)): vx = 0 and
     # wz = L / (L^2 + 2 b^2) = 0.8 / (0.64 + 0.32) = 5/6; the drive points sideways at 0.8 * 5/6.
-    calc = PltfClc1WD.from_config(one_wheel(0.8, 0.4))
+    calc = PltfClc1WD(projection="lsq")
+    config = one_wheel(0.8, 0.4)
+    calc.initialize(config.drives, config.passive_wheels)
     r = calc.calculate_command(Twist(0.0, 1.0, 0.0))
     assert r.changed
     assert (r.twist.vx, r.twist.vy, r.twist.wz) == pytest.approx((0.0, 0.0, 5.0 / 6.0))
@@ -121,6 +123,8 @@ def test_calculators_refuse_layouts_they_cannot_serve():
         PltfClcStd().calculate_command(Twist(1, 0, 0))
     with pytest.raises(KinematicsError, match="estimator"):
         PltfClcStd(estimator="kalman")
+    with pytest.raises(KinematicsError, match="projection must be one of axle, lsq"):
+        PltfClcStd(projection="nearest")
     with pytest.raises(KinematicsError, match="finite"):
         std().calculate_command(Twist(float("nan"), 0, 0))
 

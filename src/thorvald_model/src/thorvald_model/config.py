@@ -819,7 +819,7 @@ def _cross_field_problems(config: RobotConfig, data: Mapping) -> List[Problem]:
                     )
                 )
 
-    problems.extend(layout_problems(config))
+    problems.extend(layout_problems(config.base_calculator, config.drives, config.passive_wheels))
     return problems
 
 

@@ -2,8 +2,9 @@
 
 A calculator turns a body twist into per-drive joint commands and measured drive states into
 odometry. It is pure: time and states come in as numbers. The shared logic lives here (template
-method, as python-can's ``recv``/``_recv_internal``); a calculator overrides ``_check_layout``
-and, if it has a cheaper form, ``_commands``.
+method, as python-can's ``recv``/``_recv_internal``); a built-in calculator sets ``name`` (its
+plugin name), which selects its layout rules in thorvald_model.layout, and, if it has a cheaper
+form, overrides ``_commands``. A calculator of another package may override ``_check_layout``.
 
 Lifecycle, as pluginlib's: construct with no arguments (or options), ``initialize(drives,
 passive_wheels)`` once, ``set_params(drives, passive_wheels)`` when parameters change at run time
@@ -13,8 +14,10 @@ passive_wheels)`` once, ``set_params(drives, passive_wheels)`` when parameters c
 import math
 from typing import List, Optional, Sequence
 
+from thorvald_model.layout import layout_problems
+
 from ..errors import KinematicsError
-from .geometry import Layout
+from .geometry import DEFAULT_PROJECTION, PROJECTIONS, Layout
 from .odometry import DEFAULT_ESTIMATOR, ESTIMATORS, integrate_se2, make_estimator
 from .types import CommandResult, DriveCommand, DriveState, OdometryResult, Pose, Twist
 
@@ -26,14 +29,23 @@ REALISABLE_TOLERANCE = 1e-9  # [m/s]: wheel-velocity change below which a twist 
 class BaseCalculator:
     """Base class of every kinematics calculator plugin.
 
-    estimator: "lsq" (least-squares rigid-body fit, the default) or "paper" (random pairs);
-    seed: seed of the paper estimator's random pairs, for reproducible odometry.
+    estimator: odometry, "lsq" (least-squares rigid-body fit, the default) or "paper" (random pairs);
+    seed: seed of the paper estimator's random pairs, for reproducible odometry;
+    projection: how a twist the wheels cannot realise is changed, "axle" (keep wz and the speed
+    along the fixed wheels, the default) or "lsq" (closest wheel velocities); see geometry.py.
     """
 
-    def __init__(self, estimator: str = DEFAULT_ESTIMATOR, seed: Optional[int] = None):
+    name: Optional[str] = None  # the plugin name, e.g. "pltf_clc_std::PltfClcStd"
+
+    def __init__(
+        self, estimator: str = DEFAULT_ESTIMATOR, seed: Optional[int] = None, projection: str = DEFAULT_PROJECTION
+    ):
         if estimator not in ESTIMATORS:
             raise KinematicsError("estimator must be one of {}, not {!r}".format(", ".join(ESTIMATORS), estimator))
+        if projection not in PROJECTIONS:
+            raise KinematicsError("projection must be one of {}, not {!r}".format(", ".join(PROJECTIONS), projection))
         self.estimator_name = estimator
+        self.projection = projection
         self.seed = seed
         self.layout: Optional[Layout] = None
         self._estimator = None
@@ -58,7 +70,7 @@ class BaseCalculator:
             passive_wheels = self.layout.fixed_wheels if self.layout is not None else ()
         drives = tuple(drives)
         self._check_layout(drives, tuple(passive_wheels))
-        layout = Layout(drives, passive_wheels)
+        layout = Layout(drives, passive_wheels, self.projection)
         keep = self.layout is not None and len(self.layout.drives) == len(drives)
         self.layout = layout
         self._estimator = make_estimator(self.estimator_name, layout, self.seed)
@@ -66,7 +78,7 @@ class BaseCalculator:
             self._last_steering = [0.0] * len(drives)
 
     def calculate_command(self, twist: Twist) -> CommandResult:
-        """Joint commands for a body twist; the closest realisable twist if this one is not."""
+        """Joint commands for a body twist; a realisable twist (the projection's) if this one is not."""
         layout = self._require()
         vals = (float(twist.vx), float(twist.vy), float(twist.wz))
         if not all(math.isfinite(v) for v in vals):
@@ -139,7 +151,13 @@ class BaseCalculator:
 
     # ---- what a calculator specialises ----------------------------------------------------
     def _check_layout(self, drives: Sequence, passive_wheels: Sequence) -> None:
-        """Raises KinematicsError naming the problem if this calculator cannot serve the layout."""
+        """Raises KinematicsError naming the problem if this calculator cannot serve the layout.
+
+        The rules are the loader's (thorvald_model.layout), for this calculator's name.
+        """
+        problems = layout_problems(self.name or type(self).__name__, drives, passive_wheels)
+        if problems:
+            raise KinematicsError("; ".join(p.rule for p in problems))
 
     def _commands(self, twist: Twist) -> List[DriveCommand]:
         """Commands realising a realisable twist: each wheel points along its contact's velocity."""

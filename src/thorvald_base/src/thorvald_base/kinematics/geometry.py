@@ -4,14 +4,27 @@ A rigid body moving with twist t = (vx, vy, wz) moves a wheel contact at (x, y) 
 J t, J = [[1, 0, -y], [0, 1, x]]. Everything here is 3x3 at most, so plain floats beat numpy.
 
 A wheel that cannot steer (a type-1 drive rolling along base_link x, a fixed passive wheel rolling
-along its yaw) cannot slide sideways: n . J t = 0 for its lateral direction n. Those rows form the
-constraint A t = 0; B is an orthonormal basis of the twists that satisfy it.
+along its yaw) cannot slide sideways: n . J t = 0 for its axle direction n (thorvald_model.layout's
+AxleLine, the one copy of that rule). Those rows form the constraint A t = 0; B is an orthonormal
+basis of the twists that satisfy it. The loader allows one axle line only, so A has rank 0 or 1.
+
+A twist that breaks the constraint is replaced by a realisable one (the projection):
+
+* ``axle`` (default): keeps wz and the velocity along the wheels' rolling direction, and takes the
+  velocity across it from the axle (the centre of rotation lies on the axle line, at vx / wz from
+  the foot of base_link on it for an axle across x), as car-like and steered-wheel controllers do.
+  A navigation stack's (vx, 0, wz) is followed exactly in vx and wz.
+* ``lsq``: the realisable twist whose wheel velocities (drives and fixed wheels) are closest to the
+  requested one's in least squares. It may trade yaw rate for speed across the axle; choose it
+  when the command's source treats the robot as holonomic and the wheels should move as close to
+  what it asked as they can.
 """
 
 import math
 from typing import List, Sequence, Tuple
 
 from thorvald_model.constants import DRIVE_DIFF
+from thorvald_model.layout import axle_lines, common_axle
 
 from ..errors import KinematicsError
 
@@ -19,6 +32,8 @@ Vector = Tuple[float, float, float]
 Matrix = Tuple[Vector, ...]  # rows
 
 RANK_TOLERANCE = 1e-9  # a constraint row shorter than this after elimination repeats an earlier one
+PROJECTIONS = ("axle", "lsq")
+DEFAULT_PROJECTION = "axle"
 
 
 def wheel_matrix(points: Sequence[Tuple[float, float]]) -> List[List[float]]:
@@ -82,31 +97,35 @@ class Layout:
     """Geometry of the wheels a calculator serves, with the matrices it needs precomputed.
 
     drives: the motor drives (thorvald_model Drive); passive_wheels: PassiveWheel entries, of which
-    only fixed ones matter to kinematics (a caster swivels and constrains nothing).
+    only fixed ones matter to kinematics (a caster swivels and constrains nothing); projection:
+    how an unrealisable twist is made realisable, one of PROJECTIONS (see the module's docs).
     """
 
-    def __init__(self, drives: Sequence, passive_wheels: Sequence = ()):
+    def __init__(self, drives: Sequence, passive_wheels: Sequence = (), projection: str = DEFAULT_PROJECTION):
         if not drives:
             raise KinematicsError("a calculator needs at least one drive")
+        if projection not in PROJECTIONS:
+            raise KinematicsError("projection must be one of {}, not {!r}".format(", ".join(PROJECTIONS), projection))
         self.drives = tuple(drives)
         self.fixed_wheels = tuple(w for w in passive_wheels if getattr(w, "fixed", False))
+        self.projection_name = projection
         self.x = [float(d.x) for d in self.drives]
         self.y = [float(d.y) for d in self.drives]
         self.steerable = [d.type != DRIVE_DIFF for d in self.drives]
-        # Lateral direction n of each wheel that cannot steer; constraint row (n_x, n_y, x n_y - y n_x).
-        lateral = [(0.0, 1.0, d.x, d.y) for d in self.drives if d.type == DRIVE_DIFF]
-        lateral += [(-math.sin(w.yaw), math.cos(w.yaw), w.x, w.y) for w in self.fixed_wheels]
-        self.constraints = [[nx, ny, x * ny - y * nx] for nx, ny, x, y in lateral]
+        self.axle, problems = common_axle(self.drives, self.fixed_wheels)
+        if problems:
+            raise KinematicsError("; ".join(p.rule for p in problems))
+        self.fixed_axles = axle_lines((), self.fixed_wheels)  # one per fixed wheel, in order
+        self.constraints = [list(a.constraint) for a in axle_lines(self.drives, self.fixed_wheels)]
         self.basis = null_space(self.constraints)  # rows b_k; every realisable twist is sum z_k b_k
-        if not self.basis:
-            raise KinematicsError("the wheels that cannot steer leave the robot no motion at all")
         bt = transpose(self.basis)  # 3 x k
-        # The closest realisable twist compares twists by the velocities they give the wheels that
-        # define the body's motion: the drives and the fixed wheels (casters follow, so they do not).
+        # The closest realisable twist in least squares compares twists by the velocities they give
+        # the wheels that define the body's motion: the drives and the fixed wheels (casters follow,
+        # so they do not).
         points = list(zip(self.x, self.y)) + [(w.x, w.y) for w in self.fixed_wheels]
         m_all = wheel_matrix(points)
         reduced = inverse(matmul(matmul(self.basis, m_all), bt))
-        self.projection = matmul(matmul(matmul(bt, reduced), self.basis), m_all)
+        self.lsq_projection = matmul(matmul(matmul(bt, reduced), self.basis), m_all)
         # Least-squares odometry: minimise sum |J_i t - v_i|^2 over the measured drives, subject to
         # the constraints, so t = P b with b = sum J_i^T v_i.
         m_drives = wheel_matrix(list(zip(self.x, self.y)))
@@ -121,13 +140,21 @@ class Layout:
 
     @property
     def constrained(self) -> bool:
-        return len(self.basis) < 3
+        return self.axle is not None
 
     def project(self, vx: float, vy: float, wz: float) -> Vector:
-        """The realisable twist whose wheel velocities are closest (least squares) to the given one's."""
-        if not self.constrained:
+        """The realisable twist this layout's projection gives for (vx, vy, wz)."""
+        if self.axle is None:
             return (vx, vy, wz)
-        p = self.projection
+        if self.projection_name == "axle":
+            a = self.axle
+            ux, uy = a.rolling
+            along = vx * ux + vy * uy
+            # The axle's contact may not move across the axle: (v . d) + wz * moment = 0.
+            across = -wz * a.moment
+            # + 0.0 turns the -0.0 of an axle through base_link into 0.0 for whoever prints it
+            return (along * ux + across * a.dx + 0.0, along * uy + across * a.dy + 0.0, wz)
+        p = self.lsq_projection
         return (
             p[0][0] * vx + p[0][1] * vy + p[0][2] * wz,
             p[1][0] * vx + p[1][1] * vy + p[1][2] * wz,

@@ -86,9 +86,8 @@ class PaperEstimator:
         self.layout = layout
         self.rng = random.Random(seed)
         self.iterations_per_wheel = iterations_per_wheel
-        self.px = layout.x + [w.x for w in layout.fixed_wheels]
-        self.py = layout.y + [w.y for w in layout.fixed_wheels]
-        self.fixed_normals = [(-math.sin(w.yaw), math.cos(w.yaw)) for w in layout.fixed_wheels]
+        self.px = layout.x + [a.x for a in layout.fixed_axles]
+        self.py = layout.y + [a.y for a in layout.fixed_axles]
 
     def seed(self, seed: Optional[int]) -> None:
         self.rng.seed(seed)
@@ -99,8 +98,8 @@ class PaperEstimator:
         n = len(self.px)
         wvx, wvy = wheel_velocities(steering, speed)
         # Normal of a wheel rolling along (cos a, sin a): the original's (sin(-a), cos(-a)).
-        nx = [-math.sin(a) for a in steering] + [v[0] for v in self.fixed_normals]
-        ny = [math.cos(a) for a in steering] + [v[1] for v in self.fixed_normals]
+        nx = [-math.sin(a) for a in steering] + [a.dx for a in layout.fixed_axles]
+        ny = [math.cos(a) for a in steering] + [a.dy for a in layout.fixed_axles]
         px, py = self.px, self.py
         iterations = self.iterations_per_wheel * n if n > 1 else 0
         inf_count = 0

@@ -1,10 +1,7 @@
 """The standard calculator, ``pltf_clc_std::PltfClcStd`` (paper 3.2, notes 3.1)."""
 
-from typing import Sequence
+from thorvald_model.constants import STD_CALCULATOR
 
-from thorvald_model.constants import DRIVE_DIFF
-
-from ..errors import KinematicsError
 from .calculator import BaseCalculator
 
 
@@ -16,15 +13,9 @@ class PltfClcStd(BaseCalculator):
     (vx = vy = 0) with one formula: steering atan2(vy + wz x, vx - wz y), speed the norm.
 
     Wheels that cannot steer confine the centre of rotation to their common axle line (the 4WD2WS
-    robot of the paper's Figure 10 b); a twist that would make them slide is replaced by the
-    closest realisable twist, and the result says so.
+    robot of the paper's Figure 10 b); a twist that would make them slide is made realisable by the
+    calculator's projection (by default: wz and the speed along the fixed wheels kept), and the
+    result says so.
     """
 
-    def _check_layout(self, drives: Sequence, passive_wheels: Sequence) -> None:
-        steered = [d for d in drives if d.type != DRIVE_DIFF]
-        fixed = [w for w in passive_wheels if getattr(w, "fixed", False)]
-        if len(steered) < 2 and len(steered) == len(drives) and not fixed:
-            raise KinematicsError(
-                "a single steered drive on casters cannot hold the robot's heading: the standard calculator "
-                "needs two steered drives or wheels that cannot steer"
-            )
+    name = STD_CALCULATOR
