@@ -3,7 +3,13 @@ from setuptools import setup
 
 setup(
     **generate_distutils_setup(
-        packages=["thorvald_base", "thorvald_base.kinematics", "thorvald_base.msg", "thorvald_base.srv"],
+        packages=[
+            "thorvald_base",
+            "thorvald_base.bases",
+            "thorvald_base.kinematics",
+            "thorvald_base.msg",
+            "thorvald_base.srv",
+        ],
         package_dir={"": "src"},
     )
 )

@@ -1,55 +1,58 @@
 """The ``base_driver`` node (paper section 3.1; the original's ROS interface, notes section 2).
 
-Private parameters: the robot configuration (``base_calculator``, ``motor_drives``, ...), loaded
-from the robot's YAML by base_bringup.launch, and the node's own:
+The robot configuration comes from the node's private namespace (the original's launch files load
+the robot's YAML there) or, when the namespace holds none, from the file ``~robot_model`` names,
+read through the shared loader; the node then puts the validated configuration, every default
+filled in, into its private namespace, so ``rosparam get ~motor_drives`` shows what it drives.
 
-=============================  ===============================================================
-``~robot_model``               path of the YAML, named in configuration errors (optional)
-``~simple_sim``                simulate the drives (true) or drive the real base over CAN
-``~tf_prefix``                 prefix of frame and joint names, concatenated (``robot_1/``)
-``~enable_odom_tf``            broadcast odom -> base_link (default true)
-``~odom_frame_id``             default ``odom``
-``~passthrough_gazebo_odometry``  republish ``odometry/gazebo`` (a simulator's ground truth) on
-                               ``odometry/base_raw`` once it arrives (default false)
-``~rate``                      control loop rate [Hz] (default 50)
-``~command_timeout``           a command older than this stops the wheels [s] (default 0.5)
-``~twist_covariance``          36 values; default diagonal 0.001 x 5, 0.03 for the yaw rate
-``~estimator``                 odometry: ``lsq`` (default) or ``paper``
-``~projection``                unrealisable twists on a fixed axle: ``axle`` (default) or ``lsq``
-``~can_interface_type/name``   the CAN line of a real base
-=============================  ===============================================================
+Private parameters besides the configuration:
+
+=================================  ===========================================================
+``~robot_model``                   path of the YAML: read when the namespace holds no
+                                   configuration, and named in configuration errors
+``~simple_sim``                    simulate the drives (true) or drive the real base over CAN
+``~base_handle``                   the base handle (thorvald_base.bases): default
+                                   ``simple_sim`` with simple_sim true, else ``can``
+``~tf_prefix``                     prefix of frame and joint names, concatenated (``robot_1/``)
+``~enable_odom_tf``                broadcast odom -> base_link (default true)
+``~odom_frame_id``                 default ``odom``
+``~passthrough_gazebo_odometry``   republish ``odometry/gazebo`` (a simulator's ground truth)
+                                   on ``odometry/base_raw`` once it arrives (default false)
+``~rate``                          control loop rate [Hz] (default 50)
+``~command_timeout``               a command older than this stops the wheels [s] (default 0.5)
+``~twist_covariance``              36 values; default diagonal 0.001 x 5, 0.03 for the yaw rate
+``~estimator``                     odometry: ``lsq`` (default) or ``paper``
+``~projection``                    unrealisable twists on a fixed axle: ``axle`` (default) or ``lsq``
+``~can_interface_type/name``       the CAN line of a real base
+=================================  ===========================================================
+
+A bad configuration or parameter stops the node at start with a fatal log naming it, exit status 1.
 """
 
-import math
 import sys
 import threading
 
 import rospy
 import tf2_ros
-from geometry_msgs.msg import TransformStamped, Twist
+from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 from std_srvs.srv import SetBool, SetBoolResponse, Trigger, TriggerResponse
 
-from thorvald_model import ConfigError, parse_robot_config
-from thorvald_msgs.msg import (
-    BaseState,
-    BatteryArray,
-    BatteryData,
-    Controller,
-    ControllerArray,
-    MotorVars,
-    StatusFlag,
-)
+from thorvald_model import ConfigError, load_robot_config, parse_robot_config
+from thorvald_msgs.msg import BaseState, BatteryArray, ControllerArray
 from thorvald_msgs.srv import DriveParams, DriveParamsResponse
 
-from .base import BaseDriverCore, SimulatedBase
-from .errors import ThorvaldBaseError
+from . import conversions
+from .bases import create_base_handle, handle_name
+from .core import DEFAULT_TWIST_COVARIANCE, BaseDriverCore, PoseCovariance
+from .errors import ParameterError, ThorvaldBaseError
 from .plugins import load_calculator
 
 NODE_PARAMS = (
     "robot_model",
     "simple_sim",
+    "base_handle",
     "tf_prefix",
     "enable_odom_tf",
     "odom_frame_id",
@@ -63,54 +66,62 @@ NODE_PARAMS = (
     "can_interface_name",
     "joint_states_remap_to",
 )
-DEFAULT_TWIST_COVARIANCE = [0.0] * 36
-for _i, _v in enumerate((0.001, 0.001, 0.001, 0.001, 0.001, 0.03)):
-    DEFAULT_TWIST_COVARIANCE[_i * 7] = _v
-MOVING = 0.005  # [m/s], [rad/s]: faster than this, the pose covariance grows (the original's rule)
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
+STATUS_PERIOD = 1.0  # [s] between battery_data / motor_controller_data messages
+EXIT_REFUSED = 1  # exit status when the node refuses to start
 
 
-def set_yaw(quaternion, yaw):
-    """Fills a geometry_msgs/Quaternion with a rotation of yaw [rad] about z."""
-    quaternion.x, quaternion.y = 0.0, 0.0
-    quaternion.z, quaternion.w = math.sin(yaw / 2.0), math.cos(yaw / 2.0)
+def load_config(params: dict):
+    """The robot configuration: the private namespace's, else the ~robot_model file's."""
+    if any(key not in NODE_PARAMS for key in params):
+        source = params.get("robot_model") or rospy.resolve_name("~") + " parameters"
+        return parse_robot_config(params, source, ignore=NODE_PARAMS), False
+    path = params.get("robot_model")
+    if not path:
+        raise ParameterError(
+            "~robot_model: <missing>: no robot configuration: give the robot's YAML file as ~robot_model "
+            "or load it into the node's private namespace"
+        )
+    return load_robot_config(str(path)), True
+
+
+def number(params: dict, key: str, default: float) -> float:
+    value = params.get(key, default)
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"~{key}: {value!r}: must be a number") from None
 
 
 class BaseDriverNode:
     def __init__(self):
         params = rospy.get_param("~", {})
-        source = params.get("robot_model") or rospy.resolve_name("~") + " parameters"
-        self.config = parse_robot_config(params, source, ignore=NODE_PARAMS)
+        self.config, from_file = load_config(params)
         self.tf_prefix = str(params.get("tf_prefix", ""))
         self.odom_frame = str(params.get("odom_frame_id", "odom"))
         self.base_frame = self.tf_prefix + "base_link"
         self.enable_tf = bool(params.get("enable_odom_tf", True))
-        self.rate = float(params.get("rate", 50.0))
+        self.rate = number(params, "rate", 50.0)
         if not self.rate > 0:
-            raise ThorvaldBaseError(f"~rate: {self.rate!r}: must be > 0 [Hz]")
-        cov = params.get("twist_covariance", DEFAULT_TWIST_COVARIANCE)
-        if not isinstance(cov, list) or len(cov) != 36 or not all(isinstance(v, (int, float)) for v in cov):
-            raise ThorvaldBaseError(f"~twist_covariance: {cov!r}: must be a list of 36 numbers (row-major 6x6)")
-        self.twist_cov = [float(v) for v in cov]
-        self.pose_cov = list(self.twist_cov)
-
-        if not params.get("simple_sim", False):
-            raise ThorvaldBaseError(
-                "~simple_sim: false: the CAN base is not available yet; set simple_sim:=true to simulate the drives"
-            )
-        handle = SimulatedBase(self.config)
+            raise ParameterError(f"~rate: {self.rate!r}: must be > 0 [Hz]")
+        self.covariance = PoseCovariance(params.get("twist_covariance", DEFAULT_TWIST_COVARIANCE))
         calculator = load_calculator(
             self.config,
             estimator=str(params.get("estimator", "lsq")),
             projection=str(params.get("projection", "axle")),
         )
-        self.core = BaseDriverCore(
-            self.config, calculator, handle, command_timeout=float(params.get("command_timeout", 0.5))
-        )
+        command_timeout = number(params, "command_timeout", 0.5)
+        handle = create_base_handle(self.config, params)
+        try:
+            self.core = BaseDriverCore(self.config, calculator, handle, command_timeout=command_timeout)
+        except ThorvaldBaseError:
+            handle.close()
+            raise
+        if from_file:
+            for key, value in self.config.to_dict().items():
+                rospy.set_param("~" + key, value)
         self.lock = threading.Lock()
-        self.joint_names = []
-        for d in self.config.drives:
-            self.joint_names += [self.tf_prefix + d.steering_name, self.tf_prefix + d.wheel_name]
+        self.joint_names = conversions.joint_names(self.config.drives, self.tf_prefix)
 
         self.odom_pub = rospy.Publisher("odometry/base_raw", Odometry, queue_size=10)
         self.joint_pub = rospy.Publisher("joint_states", JointState, queue_size=10)
@@ -129,9 +140,10 @@ class BaseDriverNode:
         rospy.Service("~set_drive_params", DriveParams, self.srv_set_drive_params)
         self._last_status_publish = None
         rospy.loginfo(
-            "base_driver: %d drives, calculator %s, simulated base, %.0f Hz, odom tf %s",
+            "base_driver: %d drives, calculator %s, base %s, %.0f Hz, odom tf %s",
             len(self.config.drives),
             self.config.base_calculator,
+            handle_name(params),
             self.rate,
             "on" if self.enable_tf else "off",
         )
@@ -158,7 +170,7 @@ class BaseDriverNode:
     def srv_reset_odom(self, _req):
         with self.lock:
             self.core.reset_odometry()
-            self.pose_cov = list(self.twist_cov)
+            self.covariance.reset()
         return TriggerResponse(True, "odometry pose reset to zero")
 
     def srv_safety_stop(self, req):
@@ -182,11 +194,15 @@ class BaseDriverNode:
         while not rospy.is_shutdown():
             now = rospy.Time.now()
             with self.lock:
+                if self.core.closed:
+                    break
                 result = self.core.step(now.to_sec())
+                if result.odometry.valid:
+                    self.covariance.update(result.odometry)
             self.publish(result, now)
             if result.twist_changed:
                 rospy.logwarn_throttle(
-                    WARN_PERIOD, "base_driver: this robot cannot realise the commanded twist; driving the closest one"
+                    WARN_PERIOD, "base_driver: this robot cannot realise the commanded twist; driving a realisable one"
                 )
             try:
                 rate.sleep()
@@ -196,122 +212,52 @@ class BaseDriverNode:
                 break
 
     def publish(self, result, stamp):
-        commands = BaseState(drive_mode=BaseState.MODE_DRIVE)
-        commands.header.stamp = stamp
-        commands.steer_pos = [c.steering for c in result.commands]
-        commands.prop_speed = [c.speed for c in result.commands]
-        commands.channel = [1] * len(result.commands)
-        self.command_pub.publish(commands)
-
-        state = BaseState(drive_mode=BaseState.MODE_HOME if result.stopped_by == "homing" else BaseState.MODE_DRIVE)
-        state.header.stamp = stamp
-        state.prop_speed = [s.speed for s in result.states]
-        state.prop_pos = [s.wheel_angle for s in result.states]
-        state.steer_speed = [s.steering_speed for s in result.states]
-        state.steer_pos = [s.steering for s in result.states]
-        self.state_pub.publish(state)
-
-        joints = JointState(name=self.joint_names)
-        joints.header.stamp = stamp
         # core.config, not self.config: set_drive_params may have changed r_wheel since start-up
-        for d, s in zip(self.core.config.drives, result.states):
-            joints.position += [s.steering, s.wheel_angle]
-            joints.velocity += [s.steering_speed, s.speed / d.r_wheel]
-        self.joint_pub.publish(joints)
-
+        drives = self.core.config.drives
+        self.command_pub.publish(conversions.command_msg(stamp, drives, result.commands))
+        self.state_pub.publish(conversions.state_msg(stamp, drives, result.states, result.stopped_by == "homing"))
+        self.joint_pub.publish(conversions.joint_state_msg(stamp, self.joint_names, drives, result.states))
         if self.gazebo_odom is None:
             self.publish_odometry(result.odometry, stamp)
-
-        if self._last_status_publish is None or (stamp - self._last_status_publish).to_sec() >= 1.0:
+        if self._last_status_publish is None or (stamp - self._last_status_publish).to_sec() >= STATUS_PERIOD:
             self._last_status_publish = stamp
-            self.publish_status(result.time, stamp)
+            handle = self.core.handle
+            batteries = handle.batteries(result.time)
+            if batteries:
+                self.battery_pub.publish(conversions.battery_array_msg(stamp, batteries))
+            controllers = handle.controllers(result.time)
+            if controllers:
+                self.controller_pub.publish(conversions.controller_array_msg(stamp, controllers))
 
-    def publish_odometry(self, odom, stamp):
-        if not odom.valid:
+    def publish_odometry(self, odometry, stamp):
+        if not odometry.valid:
             rospy.logwarn_throttle(WARN_PERIOD, "base_driver: odometry calculation failed (non-finite drive states)")
             return
-        t, p = odom.twist, odom.pose
-        if abs(t.vx) > MOVING or abs(t.vy) > MOVING or abs(t.wz) > MOVING:
-            # Rate-independent growth: the twist covariance per second of motion.
-            self.pose_cov = [a + b * odom.dt for a, b in zip(self.pose_cov, self.twist_cov)]
-        msg = Odometry()
-        msg.header.stamp = stamp
-        msg.header.frame_id = self.odom_frame
-        msg.child_frame_id = self.base_frame
-        msg.pose.pose.position.x, msg.pose.pose.position.y = p.x, p.y
-        set_yaw(msg.pose.pose.orientation, p.yaw)
-        msg.pose.covariance = self.pose_cov
-        msg.twist.twist.linear.x, msg.twist.twist.linear.y, msg.twist.twist.angular.z = t.vx, t.vy, t.wz
-        msg.twist.covariance = self.twist_cov
+        msg = conversions.odometry_msg(
+            stamp,
+            self.odom_frame,
+            self.base_frame,
+            odometry,
+            pose_covariance=self.covariance.pose,
+            twist_covariance=self.covariance.twist,
+        )
         self.odom_pub.publish(msg)
         if self.tf is not None:
-            tf = TransformStamped()
-            tf.header = msg.header
-            tf.child_frame_id = self.base_frame
-            tf.transform.translation.x, tf.transform.translation.y = p.x, p.y
-            set_yaw(tf.transform.rotation, p.yaw)
-            self.tf.sendTransform(tf)
-
-    def publish_status(self, time, stamp):
-        handle = self.core.handle
-        batteries = handle.batteries(time)
-        if batteries:
-            msg = BatteryArray()
-            msg.header.stamp = stamp
-            for b in batteries:
-                data = BatteryData(
-                    battery_id=b.id,
-                    battery_state=b.state,
-                    state_of_charge=b.state_of_charge,
-                    state_of_health=b.state_of_health,
-                    battery_voltage=b.voltage,
-                    battery_current=b.current,
-                    charge_fet_on=b.charge_fet_on,
-                    discharge_fet_on=b.discharge_fet_on,
-                    cycle_count=b.cycle_count,
-                    battery_capacity=b.capacity,
-                    temperatures=list(b.temperatures),
-                )
-                for alarm in b.alarms:
-                    setattr(data.battery_alarms, alarm, True)
-                msg.batteries.append(data)
-            self.battery_pub.publish(msg)
-        controllers = handle.controllers(time)
-        if controllers:
-            msg = ControllerArray()
-            msg.header.stamp = stamp
-            for c in controllers:
-                msg.controllers.append(
-                    Controller(
-                        name=c.name,
-                        type=c.type,
-                        version=c.version,
-                        can_id=c.can_id,
-                        controller_mode=c.mode,
-                        battery_volts=c.battery_volts,
-                        battery_amps=c.battery_amps,
-                        temps=list(c.temps),
-                        status_flags=[StatusFlag(n, v) for n, v in c.status_flags],
-                        motor_vars=[MotorVars(*v) for v in c.motor_vars],
-                    )
-                )
-            self.controller_pub.publish(msg)
+            self.tf.sendTransform(conversions.odometry_transform(msg))
 
     def shutdown(self):
+        """rospy's shutdown hook: the drives get a zero-speed command before the handle is closed."""
         with self.lock:
-            self.core.safety_stop(True)
-            self.core.handle.close()
+            self.core.shutdown(rospy.get_time())
+        rospy.loginfo("base_driver: wheels stopped, base closed")
 
 
 def main():
     rospy.init_node("base_driver")
     try:
         node = BaseDriverNode()
-    except ConfigError as e:
+    except (ConfigError, ThorvaldBaseError) as e:
         rospy.logfatal("base_driver: refusing to start: %s", e)
-        sys.exit(1)
-    except ThorvaldBaseError as e:
-        rospy.logfatal("base_driver: refusing to start: %s", e)
-        sys.exit(1)
+        sys.exit(EXIT_REFUSED)
     rospy.on_shutdown(node.shutdown)
     node.spin()

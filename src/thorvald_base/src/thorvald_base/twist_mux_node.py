@@ -33,10 +33,15 @@ class TwistMuxNode:
         rate = float(rospy.get_param("~diagnostics_rate", 1.0))
         if rate > 0:
             self.timer = rospy.Timer(rospy.Duration(1.0 / rate), self.publish_diagnostics)
+        # the topics as subscribed, remappings applied (a launch file may remap nav_vel)
         rospy.loginfo(
             "twist_mux: inputs %s; locks %s",
-            ", ".join(f"{s.name} ({s.topic}, priority {s.priority})" for s in inputs),
-            ", ".join(f"{s.name} ({s.topic}, priority {s.priority})" for s in locks) or "none",
+            ", ".join(f"{s.name} ({sub.resolved_name}, priority {s.priority})" for s, sub in zip(inputs, self.subs)),
+            ", ".join(
+                f"{s.name} ({sub.resolved_name}, priority {s.priority})"
+                for s, sub in zip(locks, self.subs[len(inputs) :])
+            )
+            or "none",
         )
 
     def on_input(self, msg, name):

@@ -11,6 +11,7 @@ import threading
 import time
 
 import rospy
+import yaml
 from geometry_msgs.msg import Twist
 
 STARTUP_TIMEOUT = 40.0  # [s] for nodes to come up while the machine is busy
@@ -124,8 +125,10 @@ def driver_service(name, srv_type):
 
 
 def drives_from_params(driver="base_driver"):
-    """[(x, y, drive dict)] of the driver's motor_drives, in drive-index order."""
-    drives = rospy.get_param(driver + "/motor_drives")
+    """The drive dicts of the robot file the driver was started with (its ~robot_model, which the
+    launch file sets before any node runs), in drive-index order, read here with plain YAML."""
+    with open(rospy.get_param(driver + "/robot_model")) as f:
+        drives = yaml.safe_load(f)["motor_drives"]
     names = sorted(drives, key=lambda n: int(n[len("drive") :]))
     return [drives[n] for n in names]
 

@@ -1,14 +1,18 @@
 #!/usr/bin/env python3
 """base_driver refuses to start on a bad robot file, naming the key, without a traceback.
 
-Each case loads a robot file into a fresh private namespace, as base_bringup.launch does, and runs
-``rosrun thorvald_base base_driver __name:=<that namespace>`` on the rostest's master. The good
-standard robot file, run the same way, starts and drives: the refusals come from the bad values.
+Bad content: each case loads a robot file into a fresh private namespace, as the original's launch
+files do, and runs ``rosrun thorvald_base base_driver __name:=<that namespace>`` on the rostest's
+master. Unreadable files (not UTF-8, a directory, missing, no read permission): base_driver gets
+only ``~robot_model``, as base_bringup.launch gives it, and reads the file itself. The good
+standard robot file, run the same way, starts and drives: the refusals come from the bad files.
 """
 
 import os
+import shutil
 import signal
 import subprocess
+import tempfile
 import time
 import unittest
 
@@ -41,9 +45,36 @@ def start_driver(name, robot_file, **node_params):
     )
 
 
+def without_file_override():
+    """A command prefix under which root, too, is refused files it has no permission to read."""
+    if os.geteuid() != 0:
+        return []
+    caps = "-dac_override,-dac_read_search"
+    return [shutil.which("setpriv"), "--inh-caps=" + caps, "--bounding-set=" + caps]
+
+
+def start_driver_on_file(name, robot_file):
+    """base_driver with only ~robot_model (and simple_sim), as base_bringup.launch starts it."""
+    return subprocess.Popen(
+        [
+            *without_file_override(),
+            "rosrun",
+            "thorvald_base",
+            "base_driver",
+            "__name:=" + name,
+            "_robot_model:=" + robot_file,
+            "_simple_sim:=true",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        universal_newlines=True,
+        start_new_session=True,
+    )
+
+
 class BadConfigTest(unittest.TestCase):
-    def refuses(self, name, robot_file, key, **node_params):
-        proc = start_driver(name, robot_file, **node_params)
+    def refuses(self, name, robot_file, key, proc=None, **node_params):
+        proc = proc or start_driver(name, robot_file, **node_params)
         try:
             out, err = proc.communicate(timeout=EXIT_TIMEOUT)
         except subprocess.TimeoutExpired:
@@ -68,14 +99,51 @@ class BadConfigTest(unittest.TestCase):
         err = self.refuses("bad_r_wheel", os.path.join(DATA, "bad_r_wheel_type.yaml"), "motor_drives.drive2.r_wheel")
         self.assertIn("'big'", err)
 
+    def refuses_unreadable(self, name, make, reason):
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "robot.yaml")
+            make(path)
+            err = self.refuses(name, path, f"{path}: {reason}", proc=start_driver_on_file(name, path))
+        fatal = [line for line in err.splitlines() if "FATAL" in line]
+        self.assertEqual(len(fatal), 1, err)
+        return err
+
+    def test_file_that_is_not_utf8(self):
+        def latin1(path):
+            with open(GOOD, "rb") as good, open(path, "wb") as f:
+                f.write("# Ås\n".encode("latin-1") + good.read())
+
+        self.refuses_unreadable("not_utf8", latin1, "not a text file: byte 0xc5 at offset 2 is not UTF-8")
+
+    def test_directory(self):
+        self.refuses_unreadable("a_directory", os.mkdir, "cannot read the robot configuration: Is a directory")
+
+    def test_missing_file(self):
+        self.refuses_unreadable(
+            "missing_file", lambda path: None, "cannot read the robot configuration: No such file or directory"
+        )
+
+    def test_file_without_read_permission(self):
+        def no_permission(path):
+            shutil.copy(GOOD, path)
+            os.chmod(path, 0)
+
+        self.refuses_unreadable(
+            "no_permission", no_permission, "cannot read the robot configuration: Permission denied"
+        )
+
     def test_bad_node_parameter(self):
         self.refuses("bad_rate", GOOD, "~rate", rate=-5.0)
 
     def test_good_file_starts(self):
-        # the same way of starting the node, with the good file: it runs and publishes odometry
+        # the same ways of starting the node, with the good file: it runs and publishes odometry
+        for name, start in (("good_driver", start_driver), ("good_driver_on_file", start_driver_on_file)):
+            with self.subTest(start=start.__name__):
+                self.starts_and_publishes(start(name, GOOD))
+
+    def starts_and_publishes(self, proc):
         received = []
         sub = rospy.Subscriber("/odometry/base_raw", Odometry, received.append)
-        proc = start_driver("good_driver", GOOD)
         try:
             deadline = time.time() + EXIT_TIMEOUT
             while time.time() < deadline and not received and proc.poll() is None:

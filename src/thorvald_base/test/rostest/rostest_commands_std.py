@@ -52,6 +52,26 @@ class CommandsStdTest(unittest.TestCase):
             sorted((d["x"], d["y"]) for d in self.drives), [(-0.547, -0.3), (-0.547, 0.3), (0.547, -0.3), (0.547, 0.3)]
         )
 
+    def test_commands_carry_each_drives_steering_speed_limit_and_channel(self):
+        # steer_max_speed is the configured steering speed str_sim_v [rad/s]; every type-0 drive has a
+        # controller of its own, so its propulsion is channel 1
+        msg = self.commands.wait_for(lambda m: len(m.steer_max_speed) == 4, timeout=WAIT)
+        self.assertIsNotNone(msg, describe(self.commands.latest()))
+        self.assertEqual(list(msg.steer_max_speed), [float(d["str_sim_v"]) for d in self.drives])
+        self.assertEqual(list(msg.channel), [1, 1, 1, 1])
+
+    def test_the_configuration_is_in_the_private_namespace_with_defaults_filled_in(self):
+        # base_driver read the file itself; what it drives is visible as the original's parameters,
+        # with the defaults of keys the file leaves out
+        drives = rospy.get_param("base_driver/motor_drives")
+        self.assertEqual(sorted(drives), ["drive0", "drive1", "drive2", "drive3"])
+        for k, d in enumerate(self.drives):
+            got = drives[f"drive{k}"]
+            self.assertEqual((got["x"], got["y"], got["node"]), (d["x"], d["y"], d["node"]))
+            self.assertEqual(got["str_sim_v"], d["str_sim_v"])
+            self.assertEqual(got["w_wheel"], 0.16)  # not in the file: the default
+        self.assertEqual(rospy.get_param("base_driver/base_calculator"), "pltf_clc_std::PltfClcStd")
+
     def test_translation_and_rotation(self):
         # vx 0.5, vy 0.2, wz 0.3: e.g. drive1 at (0.547, -0.3) rolls along (0.5 + 0.09, 0.2 + 0.1641)
         # = (0.59, 0.3641): steering 0.5529 rad, speed 0.6933 m/s. All angles stay below 90 degrees.

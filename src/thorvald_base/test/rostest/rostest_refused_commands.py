@@ -55,14 +55,17 @@ class RefusedCommandsTest(unittest.TestCase):
     def check_refused(self, bad):
         """The previous command stands while bad ones stream, then the wheels stop at its timeout."""
         self.drive_good()
+        # From here on every joint_commands follows the good command: a stopped one that base_driver
+        # published before it took the command may still arrive after the command was sent.
+        driving = time.time()
         last_good = self.cmd.stop()
         self.cmd.send(bad)
-        first_stop = self.commands.wait_for(stopped, timeout=TIMEOUT + WAIT, since=last_good)
+        first_stop = self.commands.wait_for(stopped, timeout=TIMEOUT + WAIT, since=driving)
         self.assertIsNotNone(first_stop, "the wheels were never stopped: " + describe(self.commands.latest()))
         delay = first_stop.header.stamp.to_sec() - last_good
         self.assertGreaterEqual(delay, TIMEOUT, "the bad command replaced the good one")
         self.assertLessEqual(delay, TIMEOUT + 0.02 + MARGIN, "the wheels did not stop at the good command's timeout")
-        before = [m for m in self.commands.since(last_good) if m.header.stamp < first_stop.header.stamp]
+        before = [m for m in self.commands.since(driving) if m.header.stamp < first_stop.header.stamp]
         self.assertTrue(before)
         for m in before:
             self.assertTrue(speeds_are(m, GOOD), describe(m))

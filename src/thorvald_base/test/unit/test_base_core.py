@@ -5,7 +5,8 @@ import math
 import pytest
 from base_test_helpers import EXAMPLE_ROBOTS, four_ws
 
-from thorvald_base.base import BaseDriverCore, SimulatedBase
+from thorvald_base.bases.simulated import SimulatedBase
+from thorvald_base.core import BaseDriverCore
 from thorvald_base.kinematics import PltfClcStd
 from thorvald_model import load_robot_config
 

@@ -103,7 +103,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     elif configs:
         print(format_table([summary(c) for c in configs]))
     if failed:
-        print(f"{failed} of {len(args.files)} file(s) invalid", file=sys.stderr)
+        if len(args.files) > 1:
+            print(f"{failed} of {len(args.files)} file(s) invalid", file=sys.stderr)
         return 2
     return 0
 

@@ -80,10 +80,19 @@ class Drive:
     wheel_name: str  # joint name without tf_prefix, default "wheelN"
     tower: bool  # a tower module stands above the drive (model only)
     suspension: Optional[Suspension] = None
+    channel: int = 1  # propulsion channel on its motor controller: 2 for the second type-1 drive of a node
 
     @property
     def steerable(self) -> bool:
         return self.type == DRIVE_STEERED
+
+    @property
+    def max_steering_speed(self) -> float:
+        """The steering speed the drive is allowed [rad/s]: ``str_sim_v``, 0 for a type-1 drive.
+
+        The simulated drive slews at it; on a real base it is the controller's steering speed limit.
+        """
+        return self.str_sim_v if self.steerable else 0.0
 
     @property
     def max_wheel_speed(self) -> float:
@@ -443,12 +452,24 @@ TOP_LEVEL_KEYS = ("base_calculator", *(s.key for s in SECTIONS), *PASSTHROUGH_KE
 # Loading
 # ---------------------------------------------------------------------------------------------
 def load_robot_config(path: str) -> RobotConfig:
-    """Loads and validates a robot configuration file; raises ConfigError naming every problem."""
+    """Loads and validates a robot configuration file; raises ConfigError naming every problem.
+
+    A file that cannot be read at all (missing, a directory, no permission, not UTF-8 text, not
+    YAML) raises a ConfigError with one problem at the top level, which formats as one line.
+    """
     try:
-        with open(path) as f:
+        # Bytes, so that PyYAML decodes (UTF-8, or UTF-16 with a byte order mark) and reports where
+        # decoding fails, whatever the locale.
+        with open(path, "rb") as f:
             data = yaml.safe_load(f)
     except OSError as e:
-        raise ConfigError(path, [Problem("", MISSING, f"cannot read the file: {e.strerror}")]) from None
+        raise ConfigError(path, [Problem("", MISSING, f"cannot read the robot configuration: {e.strerror}")]) from None
+    except yaml.reader.ReaderError as e:
+        if e.encoding == "unicode":
+            reason = f"character #x{e.character:04x} at offset {e.position} is not allowed in a YAML file"
+        else:
+            reason = f"byte 0x{e.character:02x} at offset {e.position} is not {e.encoding.upper()} ({e.reason})"
+        raise ConfigError(path, [Problem("", MISSING, f"not a text file: {reason}")]) from None
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
@@ -488,7 +509,7 @@ def parse_robot_config(data: Any, source: str = "<robot configuration>", ignore:
         parsed[section.attr] = _parse_section(data.get(section.key), section, problems)
 
     extras = tuple((k, data[k]) for k in PASSTHROUGH_KEYS if k in data)
-    drives = _attach_suspensions(parsed["drives"], parsed["suspensions"])
+    drives = _attach_channels(_attach_suspensions(parsed["drives"], parsed["suspensions"]))
     config = RobotConfig(
         source=source,
         base_calculator=calculator if isinstance(calculator, str) else STD_CALCULATOR,
@@ -669,6 +690,16 @@ def _attach_suspensions(drives: List[Drive], suspensions: List[Suspension]) -> L
     for s in suspensions:
         by_drive.setdefault(s.drive, s)
     return [replace(d, suspension=by_drive.get(d.name)) for d in drives]
+
+
+def _attach_channels(drives: List[Drive]) -> List[Drive]:
+    """Numbers the drives that share a motor controller node 1, 2 in file order (a type-1 pair)."""
+    seen: Dict[int, int] = {}
+    out = []
+    for d in drives:
+        seen[d.node] = seen.get(d.node, 0) + 1
+        out.append(replace(d, channel=seen[d.node]) if seen[d.node] != d.channel else d)
+    return out
 
 
 def _short(value: Any) -> Any:

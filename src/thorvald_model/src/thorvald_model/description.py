@@ -54,33 +54,39 @@ def xacro_file() -> str:
     return os.path.join(rospkg.RosPack().get_path("thorvald_model"), "urdf", "thorvald_model.xacro")
 
 
-def _is_robot_config(path: str, data: Any) -> bool:
+def _is_robot_config_arg(path: str) -> bool:
     arg = xacro.substitution_args_context.get("arg", {}).get("robot_config")
-    if arg and os.path.realpath(arg) == os.path.realpath(path):
-        return True
-    return isinstance(data, dict) and "motor_drives" in data
+    return bool(arg) and os.path.realpath(arg) == os.path.realpath(path)
+
+
+def _robot_dict(load: Callable[[], Any]) -> Dict[str, Any]:
+    """The canonical dict of a robot configuration, or its ConfigError carried out of xacro."""
+    try:
+        return load().to_dict()
+    except ConfigError as e:
+        raise RobotConfigAbort(e) from None
 
 
 def _load_yaml(filename: str) -> Any:
-    """xacro's load_yaml(): same path and dependency handling, safe loading, robot files validated."""
+    """xacro's load_yaml(): same path and dependency handling, safe loading, robot files validated.
+
+    The robot_config file goes through the shared loader, which words unreadable and malformed
+    files the same way for every tool; other YAML files holding ``motor_drives`` are robot
+    configurations too and are validated after loading.
+    """
     filename = xacro.abs_filename_spec(filename)
     oldstack = xacro.push_file(filename)
     try:
-        with open(filename) as f:
-            data = yaml.safe_load(f)
-        if _is_robot_config(filename, data):
-            try:
-                return parse_robot_config(data, filename).to_dict()
-            except ConfigError as e:
-                raise RobotConfigAbort(e) from None
+        if _is_robot_config_arg(filename):
+            return _robot_dict(lambda: load_robot_config(filename))
+        try:
+            with open(filename, "rb") as f:
+                data = yaml.safe_load(f)
+        except (OSError, yaml.YAMLError) as e:
+            raise xacro.XacroException(f"cannot load YAML file {filename}: {e}") from None
+        if isinstance(data, dict) and "motor_drives" in data:
+            return _robot_dict(lambda: parse_robot_config(data, filename))
         return data
-    except (OSError, yaml.YAMLError) as e:
-        if _is_robot_config(filename, None):
-            try:  # the loader words unreadable and malformed files the same way for every tool
-                load_robot_config(filename)
-            except ConfigError as error:
-                raise RobotConfigAbort(error) from None
-        raise xacro.XacroException(f"cannot load YAML file {filename}: {e}") from None
     finally:
         xacro.restore_filestack(oldstack)
         xacro.all_includes.append(filename)

@@ -31,11 +31,18 @@ class Problem:
 
 
 class ConfigError(ThorvaldModelError):
-    """A robot configuration breaks one or more rules; every problem found is listed."""
+    """A robot configuration breaks one or more rules; every problem found is listed.
+
+    A file that cannot be read at all is one problem of the whole file (path "", no value), and
+    formats as one line: ``FILE: reason``.
+    """
 
     def __init__(self, source: str, problems: Sequence[Problem]):
         self.source = source
         self.problems = tuple(problems)
+        if len(self.problems) == 1 and self.problems[0].path == "" and self.problems[0].value is MISSING:
+            super().__init__(f"{source}: {self.problems[0].rule}")
+            return
         lines = [p.format(source) for p in self.problems]
         header = "{}: invalid robot configuration ({} problem{}):".format(
             source, len(lines), "" if len(lines) == 1 else "s"

@@ -11,7 +11,8 @@ Runs xacro's own ``main()`` (xacro 1.13, the ROS 1 flavour: same options, same o
 
 xacro evaluates the ``<robot name="$(arg robot_name)">`` attribute before the ``<xacro:arg>``
 elements inside it, so an absent ``robot_name:=`` gets the robot file's base name here, as
-:func:`thorvald_model.description.generate_urdf` does.
+:func:`thorvald_model.description.generate_urdf` does. A relative ``robot_config:=`` is taken from
+the working directory, as a user typing it expects (xacro would look next to the xacro file).
 
 Launch files call it by name (``command="rosrun thorvald_model xacro ..."``): the PyPI xacro is
 not a ROS package, so ``$(find xacro)/xacro`` does not exist here.
@@ -42,12 +43,20 @@ def _safe_default_loader() -> None:
 
 
 def _with_robot_name(argv: List[str]) -> List[str]:
+    argv = [_absolute_config(a) for a in argv]
     names = [a.split(":=", 1)[0] for a in argv if ":=" in a and not a.startswith("_")]
     if "robot_name" in names:
         return argv
     configs = [a.split(":=", 1)[1] for a in argv if a.startswith("robot_config:=")]
     name = os.path.splitext(os.path.basename(configs[-1]))[0] if configs and configs[-1] else "thorvald_ii"
     return [*argv, "robot_name:=" + name]
+
+
+def _absolute_config(arg: str) -> str:
+    key, sep, value = arg.partition(":=")
+    if key == "robot_config" and sep and value and not value.startswith("$") and not os.path.isabs(value):
+        return "robot_config:=" + os.path.abspath(value)
+    return arg
 
 
 def main(argv: Optional[List[str]] = None) -> int:

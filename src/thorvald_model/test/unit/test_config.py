@@ -428,10 +428,61 @@ def test_yaml_syntax_error_names_the_line(tmp_path):
     assert str(path) in str(info.value)
 
 
-def test_missing_file(tmp_path):
+def unreadable(path):
+    """The one-line message load_robot_config gives for a file it cannot read."""
     with pytest.raises(ConfigError) as info:
-        load_robot_config(str(tmp_path / "nope.yaml"))
-    assert "cannot read the file" in str(info.value)
+        load_robot_config(str(path))
+    text = str(info.value)
+    assert "\n" not in text, text
+    assert text.startswith(f"{path}: ")
+    return text
+
+
+def test_missing_file(tmp_path):
+    assert unreadable(tmp_path / "nope.yaml").endswith("cannot read the robot configuration: No such file or directory")
+
+
+def test_directory(tmp_path):
+    (tmp_path / "robot.yaml").mkdir()
+    assert unreadable(tmp_path / "robot.yaml").endswith("cannot read the robot configuration: Is a directory")
+
+
+def test_file_that_is_not_utf8(tmp_path):
+    path = tmp_path / "latin1.yaml"
+    path.write_bytes("motor_drives: {drive0: {node: 1, x: 0, y: 0}}  # Ås\n".encode("latin-1"))
+    # "Å" is 0xc5 in Latin-1; in UTF-8 it would start a two-byte sequence that "s" cannot continue
+    offset = path.read_bytes().index(b"\xc5")
+    assert unreadable(path).endswith(
+        f"not a text file: byte 0xc5 at offset {offset} is not UTF-8 (invalid continuation byte)"
+    )
+
+
+def test_binary_file(tmp_path):
+    path = tmp_path / "robot.yaml"
+    path.write_bytes(b"motor_drives: \x00\x01\x02")
+    assert "character #x0000 at offset 14 is not allowed in a YAML file" in unreadable(path)
+
+
+def test_a_problem_of_the_content_keeps_the_multi_line_report(tmp_path):
+    path = tmp_path / "robot.yaml"
+    path.write_text("motor_drives: {drive0: {node: 1, x: 0, y: 0, r_wheel: -1}}\n")
+    with pytest.raises(ConfigError) as info:
+        load_robot_config(str(path))
+    assert str(info.value).splitlines()[1].strip() == f"{path}: motor_drives.drive0.r_wheel: -1: must be > 0"
+
+
+def test_drives_sharing_a_controller_get_its_channels_in_file_order():
+    config = parse_robot_config(
+        {
+            "motor_drives": {
+                "drive0": {"node": 7, "x": 0.0, "y": -0.3, "type": 1},
+                "drive1": {"node": 2, "x": 0.8, "y": 0.0},
+                "drive2": {"node": 7, "x": 0.0, "y": 0.3, "type": 1},
+            }
+        }
+    )
+    assert [d.channel for d in config.drives] == [1, 1, 2]
+    assert [d.max_steering_speed for d in config.drives] == [0.0, 4.0, 0.0]
 
 
 # --- the paper's figure and the example robots -------------------------------------------------

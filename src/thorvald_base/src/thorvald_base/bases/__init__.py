@@ -1,0 +1,63 @@
+"""Base handles and the one factory that picks base_driver's handle from its parameters.
+
+The registry maps a handle name (base_driver's ``~base_handle``) to ``module:Class``, imported only
+when that handle is created (as python-can's interface registry). ``~base_handle`` defaults to
+``simple_sim`` when ``~simple_sim`` is true; with ``simple_sim`` false it names the CAN base,
+``can``, which a later release registers.
+
+=============  ==============================================================================
+name           handle
+=============  ==============================================================================
+``simple_sim`` :class:`~thorvald_base.bases.simulated.SimulatedBase`: drives simulated in the
+               node, ramping at ``prp_sim_a`` and slewing at ``str_sim_v``
+=============  ==============================================================================
+"""
+
+import importlib
+from typing import Dict, List
+
+from ..errors import ParameterError
+from .handle import BaseHandle, BatteryInfo, ControllerInfo, MeasuredDrive
+
+BASE_HANDLES: Dict[str, str] = {
+    "simple_sim": "thorvald_base.bases.simulated:SimulatedBase",
+}
+
+
+def handle_name(params: dict) -> str:
+    """The handle base_driver's private parameters ask for."""
+    name = params.get("base_handle")
+    if name:
+        return str(name)
+    return "simple_sim" if params.get("simple_sim", False) else "can"
+
+
+def known_handles() -> List[str]:
+    return sorted(BASE_HANDLES)
+
+
+def create_base_handle(config, params: dict) -> BaseHandle:
+    """The base handle named by ``params`` (base_driver's private parameters) for this robot."""
+    name = handle_name(params)
+    target = BASE_HANDLES.get(name)
+    if target is None:
+        origin = "" if params.get("base_handle") else f" (simple_sim {bool(params.get('simple_sim', False))})"
+        raise ParameterError(
+            f"~base_handle: {name!r}{origin}: no such base handle; available: {', '.join(known_handles())}"
+            + ("; set simple_sim:=true to simulate the drives" if name == "can" else "")
+        )
+    module_name, _, class_name = target.partition(":")
+    cls = getattr(importlib.import_module(module_name), class_name)
+    return cls.from_params(config, params)
+
+
+__all__ = [
+    "BASE_HANDLES",
+    "BaseHandle",
+    "BatteryInfo",
+    "ControllerInfo",
+    "MeasuredDrive",
+    "create_base_handle",
+    "handle_name",
+    "known_handles",
+]

@@ -1,0 +1,180 @@
+"""The hardware side of base_driver (the original's BaseCtrl, paper Figure 6), without ROS.
+
+A :class:`BaseHandle` sends drive commands, reads drive states, motor controllers and batteries,
+homes the steering, and stops the wheels before it lets go of the hardware. The shared logic and
+the contract live here; a handle implements the ``_``-prefixed methods (template method, as
+python-can's BusABC with ``send``/``_send_internal``).
+
+Times are seconds on whichever clock the node uses (ROS time, simulated time in simulation).
+"""
+
+from dataclasses import dataclass
+from typing import List, Optional, Sequence, Tuple
+
+from thorvald_model.config import RobotConfig
+
+from ..errors import ThorvaldBaseError
+from ..kinematics import DriveCommand, DriveState
+
+# Modes of Controller.controller_mode, the MODE_* values of thorvald_msgs/BaseState.
+MODE_DRIVE = 0
+MODE_HOME = 1
+MODE_ONLINE = 3
+MODE_LOST_CONNECTION = 4
+
+
+@dataclass(frozen=True)
+class MeasuredDrive:
+    """A drive's measured state with the rates a BaseState carries."""
+
+    steering: float  # [rad]
+    speed: float  # wheel rim speed [m/s]
+    wheel_angle: float  # [rad]
+    steering_speed: float  # [rad/s]
+
+    def as_state(self) -> DriveState:
+        return DriveState(self.steering, self.speed, self.wheel_angle)
+
+
+@dataclass(frozen=True)
+class BatteryInfo:
+    """One battery as battery_data reports it (thorvald_msgs/BatteryData)."""
+
+    id: int
+    state: int  # 0 ok, 1 alarm, 2 lost connection
+    state_of_charge: float  # [%]
+    state_of_health: float  # [%]
+    voltage: float  # [V]
+    current: float  # [A]
+    charge_fet_on: bool = True
+    discharge_fet_on: bool = True
+    cycle_count: int = 0
+    capacity: float = 0.0  # [Ah]
+    temperatures: Tuple[float, ...] = ()  # [degC]
+    alarms: Tuple[str, ...] = ()  # names of the BatteryAlarms flags that are set
+
+
+@dataclass(frozen=True)
+class ControllerInfo:
+    """One motor controller as motor_controller_data reports it (thorvald_msgs/Controller)."""
+
+    name: str
+    type: str
+    version: str
+    can_id: int
+    mode: int
+    battery_volts: float = 0.0  # [V]
+    battery_amps: float = 0.0  # [A]
+    temps: Tuple[float, ...] = ()  # [degC]
+    status_flags: Tuple[Tuple[str, bool], ...] = ()
+    motor_vars: Tuple[Tuple[str, float, float, float, float], ...] = ()  # (type, speed, position, amps, power)
+
+
+class BaseHandle:
+    """The hardware side of base_driver: drives, motor controllers, batteries.
+
+    Contract, for every handle:
+
+    * ``send_drive_commands`` once per cycle, one command per drive after the drive layer;
+      ``read_drive_states`` the latest measured state of every drive, in drive order.
+    * ``home_steering`` starts homing; ``homing`` is true until the handle ends it (the homing is
+      done) or base_driver calls ``end_homing`` because a new velocity command arrived. What the
+      drives do meanwhile is the handle's business.
+    * ``close`` stops the wheels (zero speed, the steering where it was commanded) before the
+      hardware is released; after it, nothing is sent.
+    """
+
+    def __init__(self, config: RobotConfig):
+        self.config = config
+        self._homing = False
+        self._closed = False
+        self._last_commands: Optional[Tuple[DriveCommand, ...]] = None
+        self._last_time: Optional[float] = None
+
+    @classmethod
+    def from_params(cls, config: RobotConfig, params: dict) -> "BaseHandle":
+        """The handle for base_driver's private parameters (the factory's entry point).
+
+        A handle that needs more than the configuration (a CAN bus opened from
+        ``can_interface_type``) reads it here, so that tests can construct it directly.
+        """
+        return cls(config)
+
+    def send_drive_commands(self, commands: Sequence[DriveCommand], time: float) -> None:
+        """Sends one command per drive (after the drive layer) for time [s]."""
+        if self._closed:
+            raise ThorvaldBaseError("the base handle is closed")
+        if len(commands) != len(self.config.drives):
+            raise ThorvaldBaseError(f"expected {len(self.config.drives)} drive commands, got {len(commands)}")
+        commands = tuple(commands)
+        self._send_drive_commands(commands, time)
+        self._last_commands, self._last_time = commands, time
+
+    def read_drive_states(self, time: float) -> List["MeasuredDrive"]:
+        """The latest measured state of every drive, in drive order."""
+        return self._read_drive_states(time)
+
+    def home_steering(self) -> str:
+        """Starts homing the steering of every drive; returns a message for the caller."""
+        self._homing = True
+        return self._home_steering()
+
+    @property
+    def homing(self) -> bool:
+        return self._homing
+
+    def end_homing(self) -> None:
+        """Ends homing (a new velocity command arrived, or the handle found the homing done)."""
+        if self._homing:
+            self._homing = False
+            self._end_homing()
+
+    def set_params(self, config: RobotConfig) -> None:
+        """Takes changed drive parameters (set_drive_params) at once."""
+        self.config = config
+        self._set_params(config)
+
+    def batteries(self, time: float) -> List[BatteryInfo]:
+        return []
+
+    def controllers(self, time: float) -> List[ControllerInfo]:
+        return []
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    def stop(self, time: Optional[float] = None) -> None:
+        """Sends zero wheel speeds with the steering of the last command (or straight ahead)."""
+        last = self._last_commands or tuple(DriveCommand(0.0, 0.0) for _ in self.config.drives)
+        when = time if time is not None else (self._last_time if self._last_time is not None else 0.0)
+        self.send_drive_commands([DriveCommand(c.steering, 0.0) for c in last], when)
+
+    def close(self, time: Optional[float] = None) -> None:
+        """Stops the wheels, then releases the hardware. Closing twice does nothing."""
+        if self._closed:
+            return
+        try:
+            self.stop(time)
+        finally:
+            self._closed = True
+            self._close()
+
+    # ---- implemented by each handle -------------------------------------------------------
+    def _send_drive_commands(self, commands: Tuple[DriveCommand, ...], time: float) -> None:
+        raise NotImplementedError
+
+    def _read_drive_states(self, time: float) -> List[MeasuredDrive]:
+        raise NotImplementedError
+
+    def _home_steering(self) -> str:
+        raise NotImplementedError
+
+    def _end_homing(self) -> None:
+        """What ending the homing takes on this hardware (nothing by default)."""
+
+    def _set_params(self, config: RobotConfig) -> None:
+        raise NotImplementedError
+
+    def _close(self) -> None:
+        """Releases the hardware (nothing by default)."""

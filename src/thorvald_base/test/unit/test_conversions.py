@@ -1,0 +1,90 @@
+"""Message conversions (thorvald_base.conversions): the message types, no ROS master."""
+
+import math
+
+import pytest
+from base_test_helpers import EXAMPLE_ROBOTS
+from genpy import Time
+
+from thorvald_base import conversions
+from thorvald_base.bases import BatteryInfo, ControllerInfo, MeasuredDrive
+from thorvald_base.kinematics import DriveCommand, OdometryResult, Pose, Twist
+from thorvald_model import load_robot_config
+
+STAMP = Time(12, 500)
+
+
+def robot(name):
+    return load_robot_config(next(p for p in EXAMPLE_ROBOTS if p.endswith(name + ".yaml")))
+
+
+def test_joint_commands_carry_steering_limit_and_channel():
+    diff = robot("thorvald_ii_2wd_diff")
+    msg = conversions.command_msg(STAMP, diff.drives, [DriveCommand(0.0, 0.3), DriveCommand(0.0, -0.3)])
+    # the two type-1 drives share node 1: channels 1 and 2; they cannot steer
+    assert list(msg.channel) == [1, 2] and list(msg.steer_max_speed) == [0.0, 0.0]
+    assert list(msg.prop_speed) == [0.3, -0.3] and msg.header.stamp == STAMP
+    tall = robot("thorvald_ii_4wd2ws_tall")
+    msg = conversions.command_msg(STAMP, tall.drives, [DriveCommand(0.1, 0.2)] * 4)
+    # two steered drives (str_sim_v 4 rad/s, a controller each), two type-1 drives on one node
+    assert list(msg.steer_max_speed) == [4.0, 4.0, 0.0, 0.0]
+    assert list(msg.channel) == [1, 1, 1, 2]
+
+
+def test_base_state_round_trip():
+    config = robot("thorvald_ii_4wd4ws_std")
+    states = [MeasuredDrive(0.1 * k, 0.5, 2.0 + k, -0.2) for k in range(4)]
+    msg = conversions.state_msg(STAMP, config.drives, states, homing=True)
+    assert msg.drive_mode == msg.MODE_HOME
+    assert conversions.measured_drives(msg) == states
+    msg.prop_pos = msg.prop_pos[:3]
+    with pytest.raises(ValueError, match="differ in length"):
+        conversions.measured_drives(msg)
+
+
+def test_joint_states_give_wheel_angular_speed():
+    config = robot("thorvald_ii_4wd4ws_std")
+    names = conversions.joint_names(config.drives, "robot_1/")
+    assert names[:2] == ["robot_1/steering0", "robot_1/wheel0"] and len(names) == 8
+    states = [MeasuredDrive(0.3, 0.5, 1.0, 0.1)] * 4
+    msg = conversions.joint_state_msg(STAMP, names, config.drives, states)
+    # wheel angular speed = rim speed / r_wheel = 0.5 / 0.2
+    assert list(msg.position[:2]) == [0.3, 1.0] and list(msg.velocity[:2]) == [0.1, 2.5]
+
+
+def test_odometry_and_its_transform():
+    odom = OdometryResult(Twist(0.5, 0.1, 0.2), Pose(1.0, -2.0, 2.5), 0.0, 0.02)
+    msg = conversions.odometry_msg(
+        STAMP, "odom", "r/base_link", odom, pose_covariance=[0.0] * 36, twist_covariance=[1.0] * 36
+    )
+    assert (msg.header.frame_id, msg.child_frame_id) == ("odom", "r/base_link")
+    assert conversions.quaternion_yaw(msg.pose.pose.orientation) == pytest.approx(2.5)
+    q = msg.pose.pose.orientation
+    assert math.hypot(math.hypot(q.x, q.y), math.hypot(q.z, q.w)) == pytest.approx(1.0)
+    assert (msg.twist.twist.linear.x, msg.twist.twist.linear.y, msg.twist.twist.angular.z) == (0.5, 0.1, 0.2)
+    tf = conversions.odometry_transform(msg)
+    assert (tf.header.frame_id, tf.child_frame_id) == ("odom", "r/base_link")
+    assert (tf.transform.translation.x, tf.transform.translation.y) == (1.0, -2.0)
+    assert tf.transform.rotation == q
+
+
+def test_batteries_and_controllers():
+    msg = conversions.battery_array_msg(
+        STAMP, [BatteryInfo(1, 1, 80.0, 95.0, 47.5, 3.0, alarms=("over_voltage_protection", "bms_fail"))]
+    )
+    b = msg.batteries[0]
+    assert (b.battery_id, b.battery_state, b.battery_alarms.bms_fail, b.battery_alarms.short_circuit_discharge) == (
+        1,
+        1,
+        True,
+        False,
+    )
+    with pytest.raises(ValueError, match="unknown battery alarm 'melting'"):
+        conversions.battery_array_msg(STAMP, [BatteryInfo(1, 1, 80.0, 95.0, 47.5, 3.0, alarms=("melting",))])
+    info = ControllerInfo(
+        "drive0", "t", "v", 1, 3, status_flags=(("stall", True),), motor_vars=(("propulsion", 0.5, 1.0, 2.0, 0.1),)
+    )
+    c = conversions.controller_array_msg(STAMP, [info]).controllers[0]
+    assert (c.name, c.can_id, c.controller_mode) == ("drive0", 1, 3)
+    assert (c.status_flags[0].status_name, c.status_flags[0].status_value) == ("stall", True)
+    assert (c.motor_vars[0].type, c.motor_vars[0].motor_amps) == ("propulsion", 2.0)

@@ -1,0 +1,124 @@
+"""The base handle contract (stop before close, homing), the handle factory, and the pose covariance."""
+
+import math
+
+import pytest
+from base_test_helpers import four_ws
+
+from thorvald_base.bases import BaseHandle, MeasuredDrive, create_base_handle, handle_name
+from thorvald_base.bases.simulated import SimulatedBase
+from thorvald_base.core import DEFAULT_TWIST_COVARIANCE, BaseDriverCore, PoseCovariance
+from thorvald_base.errors import ParameterError, ThorvaldBaseError
+from thorvald_base.kinematics import DriveCommand, OdometryResult, PltfClcStd, Pose, Twist
+
+
+class RecordingBase(BaseHandle):
+    """A handle that records what reaches its drives, in order, and when it was closed."""
+
+    def __init__(self, config):
+        super().__init__(config)
+        self.log = []
+
+    def _send_drive_commands(self, commands, time):
+        self.log.append(("send", time, commands))
+
+    def _read_drive_states(self, time):
+        return [MeasuredDrive(0.0, 0.0, 0.0, 0.0) for _ in self.config.drives]
+
+    def _home_steering(self):
+        self.log.append(("home",))
+        return "homing"
+
+    def _end_homing(self):
+        self.log.append(("end homing",))
+
+    def _set_params(self, config):
+        pass
+
+    def _close(self):
+        self.log.append(("close",))
+
+
+def core_with(handle):
+    calc = PltfClcStd.from_config(handle.config)
+    return BaseDriverCore(handle.config, calc, handle)
+
+
+def test_shutdown_sends_zero_speeds_with_the_steering_kept_before_closing():
+    handle = RecordingBase(four_ws())
+    core = core_with(handle)
+    core.set_command(0.0, 0.4, 0.0, 0.0)  # sideways: every wheel at +90 degrees, 0.4 m/s
+    core.step(0.0)
+    assert all(c.speed == pytest.approx(0.4) for c in handle.log[-1][2])
+    core.shutdown(0.02)
+    assert [entry[0] for entry in handle.log[-2:]] == ["send", "close"]
+    _, when, stop = handle.log[-2]
+    assert when == 0.02
+    assert all(c.speed == 0.0 and c.steering == pytest.approx(math.pi / 2) for c in stop)
+    assert core.closed and handle.closed
+
+
+def test_a_closed_handle_sends_nothing_and_closing_twice_is_harmless():
+    handle = RecordingBase(four_ws())
+    handle.close()
+    # never commanded: the stop points the wheels straight ahead
+    assert handle.log == [("send", 0.0, tuple(DriveCommand(0.0, 0.0) for _ in range(4))), ("close",)]
+    handle.close()
+    assert len(handle.log) == 2
+    with pytest.raises(ThorvaldBaseError, match="closed"):
+        handle.send_drive_commands([DriveCommand(0.0, 0.0)] * 4, 1.0)
+
+
+def test_homing_belongs_to_the_handle_and_a_new_command_ends_it():
+    handle = RecordingBase(four_ws())
+    core = core_with(handle)
+    assert core.home_steering() == "homing" and handle.homing
+    assert core.step(0.0).stopped_by == "homing"
+    assert core.set_command(0.2, 0.0, 0.0, 0.02) is None
+    assert not handle.homing and ("end homing",) in handle.log
+    assert core.step(0.04).stopped_by is None
+
+
+def test_the_simulated_base_stops_its_drives_on_close():
+    base = SimulatedBase(four_ws())
+    for k in range(50):  # 1 s at 50 Hz: up to speed (1.5 m/s^2 ramp)
+        base.send_drive_commands([DriveCommand(0.0, 0.5)] * 4, 0.02 * k)
+    base.close(1.0)
+    # the stop command reached the simulated drives: they ramp down from 0.5 m/s at 1.5 m/s^2
+    assert [d.speed for d in base.read_drive_states(1.0)] == pytest.approx([0.5 - 1.5 * 0.02] * 4)
+    assert all(d.drive.str_lim for d in base.drives)
+
+
+def test_the_factory_picks_the_handle_from_the_parameters():
+    config = four_ws()
+    assert handle_name({"simple_sim": True}) == "simple_sim"
+    assert handle_name({"simple_sim": False}) == "can"
+    assert handle_name({"simple_sim": False, "base_handle": "simple_sim"}) == "simple_sim"
+    assert isinstance(create_base_handle(config, {"simple_sim": True}), SimulatedBase)
+    with pytest.raises(ParameterError, match=r"~base_handle: 'warp': no such base handle; available: simple_sim$"):
+        create_base_handle(config, {"base_handle": "warp"})
+    with pytest.raises(ParameterError, match=r"'can' \(simple_sim False\).*available: simple_sim.*simple_sim:=true"):
+        create_base_handle(config, {"simple_sim": False})
+
+
+def odometry(vx, dt):
+    return OdometryResult(Twist(vx, 0.0, 0.0), Pose(), 0.0, dt)
+
+
+def test_pose_covariance_grows_per_second_of_motion():
+    cov = PoseCovariance()
+    assert cov.pose == cov.twist == DEFAULT_TWIST_COVARIANCE
+    assert DEFAULT_TWIST_COVARIANCE[0] == 0.001 and DEFAULT_TWIST_COVARIANCE[35] == 0.03
+    cov.update(odometry(0.004, 1.0))  # below 5 mm/s: standing still
+    assert cov.pose == DEFAULT_TWIST_COVARIANCE
+    for _ in range(50):
+        cov.update(odometry(0.5, 0.02))  # one second of motion at 50 Hz
+    assert cov.pose[0] == pytest.approx(0.002) and cov.pose[35] == pytest.approx(0.06)
+    cov.reset()
+    assert cov.pose == DEFAULT_TWIST_COVARIANCE
+
+
+@pytest.mark.parametrize("bad", [[0.1] * 35, "0.1", [0.1] * 35 + [float("nan")], [0.1] * 35 + [True]])
+def test_pose_covariance_refuses_a_bad_twist_covariance(bad):
+    with pytest.raises(ParameterError, match=r"~twist_covariance: .*36 finite numbers"):
+        PoseCovariance(bad)
