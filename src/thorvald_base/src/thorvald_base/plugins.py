@@ -75,8 +75,9 @@ class CalculatorLoader:
     """Finds and creates calculator plugins.
 
     rospack: a rospkg.RosPack (pass one with your own ros_paths in tests); by default one over
-    ROS_PACKAGE_PATH. If thorvald_base itself is not on the package path (plain Python use), its
-    own description file next to the sources is read instead.
+    ROS_PACKAGE_PATH (the devel or install space). If thorvald_base itself is not on the package
+    path (plain Python use of the source tree), its own description file next to the sources is
+    read instead.
     """
 
     def __init__(self, rospack=None):
@@ -100,8 +101,14 @@ class CalculatorLoader:
         try:
             rp.get_path(PACKAGE)
         except rospkg.ResourceNotFound:
-            own = os.path.join(os.path.dirname(__file__), "..", "..", "calculator_plugins.xml")
-            return [(PACKAGE, os.path.normpath(own))]
+            # Plain Python use of the source tree, without a ROS environment: our own file.
+            own = os.path.normpath(os.path.join(os.path.dirname(__file__), "..", "..", "calculator_plugins.xml"))
+            if not os.path.isfile(own):
+                raise PluginDescriptionError(
+                    "thorvald_base is not on ROS_PACKAGE_PATH, so no calculator plugin can be found: source the "
+                    "workspace's devel/setup.bash or install/setup.bash"
+                ) from None
+            return [(PACKAGE, own)]
         for pkg in sorted(rp.list()):
             try:
                 manifest = rp.get_manifest(pkg)

@@ -26,8 +26,9 @@ import yaml
 from .config import load_robot_config, parse_robot_config
 from .errors import ConfigError, ThorvaldModelError
 
+# The package folder when this module runs from the source tree (or the devel space, which relays
+# to it); in an install space the package's files are under share/thorvald_model instead.
 PACKAGE_DIR = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-XACRO_FILE = os.path.join(PACKAGE_DIR, "urdf", "thorvald_model.xacro")
 
 
 class XacroError(ThorvaldModelError):
@@ -47,11 +48,23 @@ class RobotConfigAbort(BaseException):
         self.error = error
 
 
+def package_file(*parts: str) -> str:
+    """A file of the thorvald_model package: where rospack finds the package (devel or install
+    space), else next to these sources (plain Python use, no ROS environment)."""
+    return os.path.join(_package_folder(os.environ.get("ROS_PACKAGE_PATH", "")), *parts)
+
+
+@functools.lru_cache(maxsize=4)
+def _package_folder(ros_package_path: str) -> str:
+    try:
+        return rospkg.RosPack().get_path("thorvald_model")
+    except rospkg.ResourceNotFound:
+        return PACKAGE_DIR
+
+
 def xacro_file() -> str:
-    """Path of thorvald_model.xacro (source or devel space, else through rospack)."""
-    if os.path.isfile(XACRO_FILE):
-        return XACRO_FILE
-    return os.path.join(rospkg.RosPack().get_path("thorvald_model"), "urdf", "thorvald_model.xacro")
+    """Path of thorvald_model.xacro."""
+    return package_file("urdf", "thorvald_model.xacro")
 
 
 def _is_robot_config_arg(path: str) -> bool:

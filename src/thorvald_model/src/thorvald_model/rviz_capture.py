@@ -22,9 +22,8 @@ import yaml
 from PIL import Image, ImageGrab
 
 from .config import RobotConfig
-from .description import PACKAGE_DIR
+from .description import package_file
 
-RVIZ_TEMPLATE = os.path.join(PACKAGE_DIR, "rviz", "model.rviz")
 BACKGROUND = (48, 48, 48)  # model.rviz's background colour
 
 
@@ -57,7 +56,7 @@ def robot_view(config: RobotConfig) -> View:
 
 def write_rviz_config(path: str, view: View, width: int, height: int, fixed_frame: str = "base_link") -> None:
     """model.rviz turned into a bare render window of width x height showing view."""
-    with open(RVIZ_TEMPLATE) as f:
+    with open(package_file("rviz", "model.rviz")) as f:
         cfg = yaml.safe_load(f)
     cfg = copy.deepcopy(cfg)
     cfg["Panels"] = []

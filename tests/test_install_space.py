@@ -1,0 +1,163 @@
+"""``catkin_make install`` gives a working workspace, as catkin users expect.
+
+Builds the install space of src/ into a temporary folder (build, devel and install spaces of its
+own, testing off) from an environment that holds no ROS workspace, then, with only
+``install/setup.bash`` sourced: the Python packages and package files come from the install space,
+check_config and generate_urdf work on an installed example robot, the kinematics tool loads a
+calculator plugin through the installed plugin description, and base_bringup.launch brings up the
+installed base_driver, which publishes odometry.
+"""
+
+import os
+import shlex
+import signal
+import socket
+import subprocess
+import time
+
+import pytest
+
+WS = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
+VENV_PYTHON = os.path.join(WS, ".venv", "bin", "python")
+STARTUP = 90.0  # [s] for roslaunch, the master and base_driver on a busy machine
+
+
+def clean_env():
+    """The environment of a new shell: no ROS workspace, no PYTHONPATH; the virtual environment first."""
+    return {
+        "HOME": os.environ.get("HOME", "/root"),
+        "PATH": os.pathsep.join([os.path.dirname(VENV_PYTHON), "/usr/local/bin", "/usr/bin", "/bin"]),
+        "LANG": "C.UTF-8",
+    }
+
+
+@pytest.fixture(scope="module")
+def install(tmp_path_factory):
+    root = tmp_path_factory.mktemp("install_space")
+    cmd = [
+        "catkin_make",
+        "-C",
+        WS,
+        "--source",
+        os.path.join(WS, "src"),
+        "--build",
+        str(root / "build"),
+        "-DCATKIN_DEVEL_PREFIX=" + str(root / "devel"),
+        "-DCMAKE_INSTALL_PREFIX=" + str(root / "install"),
+        "-DPYTHON_EXECUTABLE=" + VENV_PYTHON,
+        "-DCATKIN_ENABLE_TESTING=OFF",
+        "install",
+        "-j2",
+    ]
+    proc = subprocess.run(cmd, env=clean_env(), capture_output=True, text=True, timeout=900)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    return str(root / "install")
+
+
+def in_install(install, script, timeout=120, check=True):
+    """Runs a bash script with only the install space sourced; returns the completed process."""
+    proc = subprocess.run(
+        ["bash", "-c", f"source {shlex.quote(install)}/setup.bash && {script}"],
+        env=clean_env(),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+    if check:
+        assert proc.returncode == 0, f"{script}\n{proc.stdout}\n{proc.stderr}"
+    return proc
+
+
+def example(install, name):
+    return os.path.join(install, "share", "thorvald_model", "config", name, name + ".yaml")
+
+
+def test_code_and_package_files_come_from_the_install_space(install):
+    out = in_install(
+        install,
+        "python -c 'import rospkg, thorvald_base, thorvald_model, thorvald_msgs.msg as m; r = rospkg.RosPack(); "
+        "print(thorvald_base.__file__, thorvald_model.__file__, m.__file__, "
+        'r.get_path("thorvald_base"), r.get_path("thorvald_model"), r.get_path("thorvald_bringup"))\'',
+    ).stdout.split()
+    assert len(out) == 6 and all(path.startswith(install + os.sep) for path in out), out
+    for path in (
+        "lib/thorvald_base/base_driver",
+        "lib/thorvald_base/twist_mux",
+        "lib/thorvald_base/kinematics",
+        "lib/thorvald_model/check_config",
+        "lib/thorvald_model/xacro",
+        "share/thorvald_base/launch/base_bringup.launch",
+        "share/thorvald_base/calculator_plugins.xml",
+        "share/thorvald_model/urdf/thorvald_model.xacro",
+        "share/thorvald_model/rviz/model.rviz",
+        "share/thorvald_bringup/launch/twist_mux.launch",
+        "share/thorvald_bringup/config/twist_mux.yaml",
+    ):
+        assert os.path.exists(os.path.join(install, path)), path
+
+
+def test_check_config_and_generate_urdf(install):
+    std = example(install, "thorvald_ii_4wd4ws_std")
+    assert "valid robot configuration" in in_install(install, f"rosrun thorvald_model check_config {std}").stdout
+    urdf = in_install(install, f"rosrun thorvald_model generate_urdf {std}").stdout
+    assert '<robot name="thorvald_ii_4wd4ws_std"' in urdf
+    assert urdf.count("<joint ") == 34 and "thorvald_model/urdf/thorvald_model.xacro" in urdf
+    assert install in urdf  # xacro's banner names the installed model
+
+
+def test_kinematics_loads_a_plugin_through_the_installed_description(install):
+    diff = example(install, "thorvald_ii_2wd_diff")
+    out = in_install(install, f"rosrun thorvald_base kinematics {diff} --twist 0.5 0 0.4").stdout
+    assert "pltf_clc_2wdiff::PltfClc2WDiff" in out
+    # v = vx - wz y: the wheels at y = -+0.275 turn at 0.5 + 0.11 and 0.5 - 0.11 m/s
+    assert "0.6100" in out and "0.3900" in out
+    source = in_install(
+        install,
+        "python -c 'from thorvald_base.plugins import CalculatorLoader; "
+        'print(CalculatorLoader().plugins["pltf_clc_2wdiff::PltfClc2WDiff"].source)\'',
+    ).stdout.strip()
+    assert source == os.path.join(install, "share", "thorvald_base", "calculator_plugins.xml")
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_base_bringup_launch(install):
+    port = free_port()
+    std = example(install, "thorvald_ii_4wd4ws_std")
+    master = f"export ROS_MASTER_URI=http://localhost:{port}"
+    launch = subprocess.Popen(
+        [
+            "bash",
+            "-c",
+            f"source {install}/setup.bash && {master} && exec roslaunch -p {port} thorvald_base base_bringup.launch "
+            f"robot_model:={std} simple_sim:=true",
+        ],
+        env=clean_env(),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        deadline = time.time() + STARTUP
+        frame = None
+        while time.time() < deadline and launch.poll() is None:
+            proc = in_install(
+                install, f"{master} && timeout 15 rostopic echo -n 1 /odometry/base_raw/child_frame_id", check=False
+            )
+            if proc.returncode == 0 and "base_link" in proc.stdout:
+                frame = proc.stdout
+                break
+            time.sleep(0.5)
+        assert frame is not None, "no odometry from the installed base_driver"
+        running = subprocess.run(["pgrep", "-af", "base_driver"], capture_output=True, text=True).stdout
+        assert os.path.join(install, "lib", "thorvald_base", "base_driver") in running, running
+    finally:
+        if launch.poll() is None:
+            os.killpg(launch.pid, signal.SIGINT)
+        out, _ = launch.communicate(timeout=60)
+    assert "base_driver: 4 drives" in out, out[-3000:]
