@@ -17,7 +17,7 @@ from typing import List, Optional, Sequence
 from thorvald_model.layout import layout_problems
 
 from ..errors import KinematicsError
-from .geometry import DEFAULT_PROJECTION, PROJECTIONS, Layout
+from .geometry import DEFAULT_PROJECTION, Layout, check_projection
 from .odometry import DEFAULT_ESTIMATOR, ESTIMATORS, integrate_se2, make_estimator
 from .types import CommandResult, DriveCommand, DriveState, OdometryResult, Pose, Twist
 
@@ -42,10 +42,8 @@ class BaseCalculator:
     ):
         if estimator not in ESTIMATORS:
             raise KinematicsError("estimator must be one of {}, not {!r}".format(", ".join(ESTIMATORS), estimator))
-        if projection not in PROJECTIONS:
-            raise KinematicsError("projection must be one of {}, not {!r}".format(", ".join(PROJECTIONS), projection))
         self.estimator_name = estimator
-        self.projection = projection
+        self.projection = check_projection(projection)
         self.seed = seed
         self.layout: Optional[Layout] = None
         self._estimator = None

@@ -36,6 +36,13 @@ PROJECTIONS = ("axle", "lsq")
 DEFAULT_PROJECTION = "axle"
 
 
+def check_projection(name: str) -> str:
+    """The projection's name, or KinematicsError listing the known ones."""
+    if name not in PROJECTIONS:
+        raise KinematicsError("projection must be one of {}, not {!r}".format(", ".join(PROJECTIONS), name))
+    return name
+
+
 def wheel_matrix(points: Sequence[Tuple[float, float]]) -> List[List[float]]:
     """M = sum J^T J over the points: the metric in which twists are compared by wheel velocities."""
     n = float(len(points))
@@ -104,11 +111,9 @@ class Layout:
     def __init__(self, drives: Sequence, passive_wheels: Sequence = (), projection: str = DEFAULT_PROJECTION):
         if not drives:
             raise KinematicsError("a calculator needs at least one drive")
-        if projection not in PROJECTIONS:
-            raise KinematicsError("projection must be one of {}, not {!r}".format(", ".join(PROJECTIONS), projection))
         self.drives = tuple(drives)
         self.fixed_wheels = tuple(w for w in passive_wheels if getattr(w, "fixed", False))
-        self.projection_name = projection
+        self.projection_name = check_projection(projection)
         self.x = [float(d.x) for d in self.drives]
         self.y = [float(d.y) for d in self.drives]
         self.steerable = [d.type != DRIVE_DIFF for d in self.drives]
