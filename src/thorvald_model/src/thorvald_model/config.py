@@ -13,17 +13,25 @@ Loading never stops at the first mistake: every problem is collected, each with 
 path, the value and the rule, and raised together in one :class:`ConfigError`.
 """
 
-import difflib
 import math
 import re
 from dataclasses import dataclass, field, replace
-from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple
-
-import yaml
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Tuple
 
 from .constants import DIFF_CALCULATOR, DRIVE_DIFF, DRIVE_STEERED, ONE_WHEEL_CALCULATOR, STD_CALCULATOR
 from .errors import MISSING, ConfigError, Problem
 from .layout import layout_problems
+from .schema import (
+    NON_NEGATIVE,
+    POSITIVE,
+    Key,
+    check_top_level,
+    in_range,
+    non_negative,
+    one_of,
+    parse_section,
+    read_yaml_file,
+)
 
 # Top-level keys that robot files of users carry for their own xacro extras (LCAS sensor frames).
 # They are kept verbatim in RobotConfig.extras and not validated.
@@ -283,48 +291,13 @@ class RobotConfig:
 # ---------------------------------------------------------------------------------------------
 # Schema
 # ---------------------------------------------------------------------------------------------
-REQUIRED = object()
-
-
-@dataclass(frozen=True)
-class Key:
-    """One key of a section entry: its type, default, rule and aliases."""
-
-    name: str
-    kind: type  # float, int, bool or str
-    default: Any = REQUIRED
-    check: Optional[Callable[[Any], bool]] = None
-    rule: str = ""
-    aliases: Tuple[str, ...] = ()
-    attr: Optional[str] = None  # dataclass field, when it differs from name
-
-
-def _positive(v):
-    return v > 0
-
-
-def _non_negative(v):
-    return v >= 0
-
-
-def _one_of(*choices):
-    return lambda v: v in choices
-
-
-def _in_range(lo, hi):
-    return lambda v: lo <= v <= hi
-
-
-POSITIVE = dict(check=_positive, rule="must be > 0")
-NON_NEGATIVE = dict(check=_non_negative, rule="must be >= 0")
-
 # The standard Thorvald II drive module: the values of every published robot file.
 DRIVE_KEYS = (
-    Key("node", int, check=_in_range(1, 127), rule="must be a CANopen node id in 1..127"),
+    Key("node", int, check=in_range(1, 127), rule="must be a CANopen node id in 1..127"),
     Key("x", float),
     Key("y", float),
-    Key("type", int, 0, _one_of(0, 1), "must be 0 (propulsion/steering) or 1 (propulsion/propulsion)"),
-    Key("leg_mesh", int, 0, _in_range(0, 6), "must be in 0..6"),
+    Key("type", int, 0, one_of(0, 1), "must be 0 (propulsion/steering) or 1 (propulsion/propulsion)"),
+    Key("leg_mesh", int, 0, in_range(0, 6), "must be in 0..6"),
     Key("r_wheel", float, 0.2, **POSITIVE),
     Key("w_wheel", float, 0.16, **POSITIVE),
     Key("prp_gr_rt", float, 42.0, **POSITIVE),
@@ -343,7 +316,7 @@ DRIVE_KEYS = (
 BATTERY_KEYS = (
     Key("id", int, None),
     Key("node", int, None),  # deprecated: id = node - 344
-    Key("type", int, 1, _one_of(0, 1), "must be 0 (empty enclosure) or 1 (KC battery)"),
+    Key("type", int, 1, one_of(0, 1), "must be 0 (empty enclosure) or 1 (KC battery)"),
     Key("x", float, 0.0),
     Key("y", float, 0.0),
     Key("z", float, 0.72),
@@ -362,7 +335,7 @@ PIPE_KEYS = (
 )
 
 CORNER_KEYS = (
-    Key("type", int, 0, _in_range(0, 3), "must be in 0..3"),
+    Key("type", int, 0, in_range(0, 3), "must be in 0..3"),
     Key("corner_mesh", int, 0, **NON_NEGATIVE),
     Key("x", float),
     Key("y", float),
@@ -378,14 +351,14 @@ BEAM_KEYS = (
 )
 
 IO_KEYS = (
-    Key("id", int, check=_non_negative, rule="must be >= 0"),
-    Key("type", int, 0, _in_range(0, 2), "must be 0 (main PCB), 1 (sister PCB) or 2 (UV lamp board)"),
+    Key("id", int, check=non_negative, rule="must be >= 0"),
+    Key("type", int, 0, in_range(0, 2), "must be 0 (main PCB), 1 (sister PCB) or 2 (UV lamp board)"),
     Key("rl0_init_state", bool, False),
     Key("rl1_init_state", bool, False),
 )
 
 PASSIVE_WHEEL_KEYS = (
-    Key("type", str, check=_one_of("caster", "fixed"), rule="must be 'caster' or 'fixed'"),
+    Key("type", str, check=one_of("caster", "fixed"), rule="must be 'caster' or 'fixed'"),
     Key("x", float),
     Key("y", float),
     Key("r_wheel", float, 0.1, **POSITIVE),
@@ -402,7 +375,7 @@ SUSPENSION_KEYS = (
 )
 
 FRAME_PART_KEYS = (
-    Key("shape", str, check=_one_of("box", "cylinder", "sphere"), rule="must be 'box', 'cylinder' or 'sphere'"),
+    Key("shape", str, check=one_of("box", "cylinder", "sphere"), rule="must be 'box', 'cylinder' or 'sphere'"),
     Key("x", float, 0.0),
     Key("y", float, 0.0),
     Key("z", float, 0.0),
@@ -415,7 +388,7 @@ FRAME_PART_KEYS = (
     Key("radius", float, 0.0, **POSITIVE),
     Key("length", float, 0.0, **POSITIVE),
     Key("mass", float, **POSITIVE),
-    Key("color", str, "grey", _one_of(*FRAME_PART_COLORS), "must be one of " + ", ".join(FRAME_PART_COLORS)),
+    Key("color", str, "grey", one_of(*FRAME_PART_COLORS), "must be one of " + ", ".join(FRAME_PART_COLORS)),
 )
 FRAME_PART_DIMENSIONS = {
     "box": ("size_x", "size_y", "size_z"),
@@ -457,25 +430,7 @@ def load_robot_config(path: str) -> RobotConfig:
     A file that cannot be read at all (missing, a directory, no permission, not UTF-8 text, not
     YAML) raises a ConfigError with one problem at the top level, which formats as one line.
     """
-    try:
-        # Bytes, so that PyYAML decodes (UTF-8, or UTF-16 with a byte order mark) and reports where
-        # decoding fails, whatever the locale.
-        with open(path, "rb") as f:
-            data = yaml.safe_load(f)
-    except OSError as e:
-        raise ConfigError(path, [Problem("", MISSING, f"cannot read the robot configuration: {e.strerror}")]) from None
-    except yaml.reader.ReaderError as e:
-        if e.encoding == "unicode":
-            reason = f"character #x{e.character:04x} at offset {e.position} is not allowed in a YAML file"
-        else:
-            reason = f"byte 0x{e.character:02x} at offset {e.position} is not {e.encoding.upper()} ({e.reason})"
-        raise ConfigError(path, [Problem("", MISSING, f"not a text file: {reason}")]) from None
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        reason = getattr(e, "problem", None) or str(e)
-        raise ConfigError(path, [Problem("", MISSING, f"not valid YAML{where}: {reason}")]) from None
-    return parse_robot_config(data, path)
+    return parse_robot_config(read_yaml_file(path), path)
 
 
 def parse_robot_config(data: Any, source: str = "<robot configuration>", ignore: Iterable[str] = ()) -> RobotConfig:
@@ -485,14 +440,10 @@ def parse_robot_config(data: Any, source: str = "<robot configuration>", ignore:
     parameters beside the robot configuration in its private namespace).
     """
     problems: List[Problem] = []
-    if data is None:
-        data = {}
-    if not isinstance(data, Mapping):
-        raise ConfigError(source, [Problem("", _short(data), "the file must hold a mapping of keys")])
-    ignore = set(ignore)
-    for key in data:
-        if key not in TOP_LEVEL_KEYS and key not in ignore:
-            problems.append(Problem(str(key), _short(data[key]), _unknown_key_rule(key, TOP_LEVEL_KEYS)))
+    try:
+        data = check_top_level(data, TOP_LEVEL_KEYS, problems, ignore)
+    except ConfigError as e:
+        raise ConfigError(source, e.problems) from None
 
     calculator = data.get("base_calculator", STD_CALCULATOR)
     if not isinstance(calculator, str) or not _CALCULATOR_NAME.match(calculator):
@@ -506,7 +457,8 @@ def parse_robot_config(data: Any, source: str = "<robot configuration>", ignore:
 
     parsed = {}
     for section in SECTIONS:
-        parsed[section.attr] = _parse_section(data.get(section.key), section, problems)
+        entries = parse_section(data.get(section.key), section.key, section.prefix, section.keys, problems)
+        parsed[section.attr] = [_build(section, name, index, values) for name, index, values in entries]
 
     extras = tuple((k, data[k]) for k in PASSTHROUGH_KEYS if k in data)
     drives = _attach_channels(_attach_suspensions(parsed["drives"], parsed["suspensions"]))
@@ -531,126 +483,6 @@ def parse_robot_config(data: Any, source: str = "<robot configuration>", ignore:
 
 
 _CALCULATOR_NAME = re.compile(r"^(\w+::\w+|[A-Za-z_][\w.]*:\w+)$")
-_ENTRY_NAME = re.compile(r"^([a-z_]+?)(\d+)$")
-
-
-def _parse_section(raw: Any, section: Section, problems: List[Problem]) -> list:
-    if raw is None:
-        return []
-    if not isinstance(raw, Mapping):
-        problems.append(
-            Problem(section.key, _short(raw), f"must be a mapping of {section.prefix}0, {section.prefix}1, ...")
-        )
-        return []
-    indexed = {}
-    for name, entry in raw.items():
-        path = f"{section.key}.{name}"
-        m = _ENTRY_NAME.match(str(name))
-        if not m or m.group(1) != section.prefix or (len(m.group(2)) > 1 and m.group(2).startswith("0")):
-            problems.append(Problem(path, MISSING, f"entries must be named {section.prefix}0, {section.prefix}1, ..."))
-            continue
-        indexed[int(m.group(2))] = (str(name), _parse_entry(entry, path, section.keys, problems))
-    for expected, index in enumerate(sorted(indexed)):
-        if index != expected:
-            problems.append(
-                Problem(
-                    f"{section.key}.{section.prefix}{expected}",
-                    MISSING,
-                    f"entries must be numbered from {section.prefix}0 without gaps ({section.prefix}{index} is there)",
-                )
-            )
-            break
-    items = []
-    for index in sorted(indexed):
-        name, values = indexed[index]
-        if values is not None:
-            items.append(_build(section, name, index, values))
-    return items
-
-
-def _parse_entry(entry: Any, path: str, keys: Sequence[Key], problems: List[Problem]) -> Optional[dict]:
-    """The entry's values with defaults filled in; None if a required key is missing or invalid.
-
-    An invalid value of a key that has a default is replaced by the default after its problem is
-    recorded, so the cross-field rules can still look at the rest of the entry.
-    """
-    if not isinstance(entry, Mapping):
-        problems.append(Problem(path, _short(entry), "must be a mapping of keys"))
-        return None
-    by_name = {}
-    for key in keys:
-        by_name[key.name] = key
-        for alias in key.aliases:
-            by_name[alias] = key
-    values = {}
-    seen_as = {}
-    for raw_key, raw_value in entry.items():
-        key_path = f"{path}.{raw_key}"
-        key = by_name.get(raw_key)
-        if key is None:
-            problems.append(Problem(key_path, raw_value, _unknown_key_rule(raw_key, list(by_name))))
-            continue
-        if key.name in seen_as:
-            problems.append(Problem(key_path, raw_value, f"'{raw_key}' is already given as '{seen_as[key.name]}'"))
-            continue
-        seen_as[key.name] = raw_key
-        ok, value = _coerce(raw_value, key.kind)
-        if not ok:
-            problems.append(Problem(key_path, raw_value, f"must be {_KIND_NAMES[key.kind]}"))
-            continue
-        if key.check is not None and value is not None and not key.check(value):
-            problems.append(Problem(key_path, raw_value, key.rule))
-            continue
-        values[key.name] = value
-    complete = True
-    for key in keys:
-        if key.name in values:
-            continue
-        if key.default is not REQUIRED:
-            values[key.name] = key.default
-            continue
-        complete = False
-        if key.name not in seen_as:
-            problems.append(Problem(f"{path}.{key.name}", MISSING, "is required"))
-    return values if complete else None
-
-
-_KIND_NAMES = {float: "a finite number", int: "an integer", bool: "true or false (or 1 or 0)", str: "a string"}
-
-
-def _coerce(value: Any, kind: type) -> Tuple[bool, Any]:
-    """Converts a YAML value to kind; numbers written as strings ("-0.425") count as numbers."""
-    if kind is str:
-        return (True, value) if isinstance(value, str) else (False, None)
-    if kind is bool:
-        if isinstance(value, bool):
-            return True, value
-        if isinstance(value, int) and value in (0, 1):
-            return True, bool(value)
-        if isinstance(value, str) and value.strip().lower() in ("true", "false", "0", "1"):
-            return True, value.strip().lower() in ("true", "1")
-        return False, None
-    if isinstance(value, bool):
-        return False, None
-    if isinstance(value, str):
-        try:
-            value = float(value.strip())
-        except ValueError:
-            return False, None
-    if not isinstance(value, (int, float)) or not math.isfinite(value):
-        return False, None
-    if kind is int:
-        if float(value) != int(value):
-            return False, None
-        return True, int(value)
-    return True, float(value)
-
-
-def _unknown_key_rule(key: Any, known: Iterable[str]) -> str:
-    known = sorted(set(known))
-    close = difflib.get_close_matches(str(key), known, n=1, cutoff=0.6)
-    hint = f"did you mean '{close[0]}'?" if close else "known keys: {}".format(", ".join(known))
-    return f"unknown key ({hint})"
 
 
 def _build(section: Section, name: str, index: int, values: dict):
@@ -700,11 +532,6 @@ def _attach_channels(drives: List[Drive]) -> List[Drive]:
         seen[d.node] = seen.get(d.node, 0) + 1
         out.append(replace(d, channel=seen[d.node]) if seen[d.node] != d.channel else d)
     return out
-
-
-def _short(value: Any) -> Any:
-    text = repr(value)
-    return value if len(text) <= 60 else text[:57] + "..."
 
 
 # ---------------------------------------------------------------------------------------------

@@ -37,14 +37,13 @@ class ConfigError(ThorvaldModelError):
     formats as one line: ``FILE: reason``.
     """
 
-    def __init__(self, source: str, problems: Sequence[Problem]):
+    def __init__(self, source: str, problems: Sequence[Problem], what: str = "robot configuration"):
         self.source = source
         self.problems = tuple(problems)
+        self.what = what
         if len(self.problems) == 1 and self.problems[0].path == "" and self.problems[0].value is MISSING:
             super().__init__(f"{source}: {self.problems[0].rule}")
             return
         lines = [p.format(source) for p in self.problems]
-        header = "{}: invalid robot configuration ({} problem{}):".format(
-            source, len(lines), "" if len(lines) == 1 else "s"
-        )
+        header = "{}: invalid {} ({} problem{}):".format(source, what, len(lines), "" if len(lines) == 1 else "s")
         super().__init__("\n".join([header] + ["  " + line for line in lines]))

@@ -1,0 +1,220 @@
+"""The machinery of a validated YAML file, shared by the robot configuration and the simulator's worlds.
+
+A file is a mapping of top-level keys; a section is a mapping of entries numbered from 0 without
+gaps (``drive0``, ``drive1``, ...); an entry is a mapping of :class:`Key` values, each with a type,
+a default, a rule and aliases. Nothing stops at the first mistake: every :class:`Problem` found
+is collected with its dotted key path, the value and the rule, and the caller raises them together
+in one :class:`ConfigError`. Pure Python (PyYAML only).
+"""
+
+import difflib
+import math
+import re
+from dataclasses import dataclass
+from typing import Any, Callable, Iterable, List, Mapping, Optional, Sequence, Tuple
+
+import yaml
+
+from .errors import MISSING, ConfigError, Problem
+
+REQUIRED = object()
+
+
+@dataclass(frozen=True)
+class Key:
+    """One key of a section entry: its type, default, rule and aliases."""
+
+    name: str
+    kind: type  # float, int, bool or str
+    default: Any = REQUIRED
+    check: Optional[Callable[[Any], bool]] = None
+    rule: str = ""
+    aliases: Tuple[str, ...] = ()
+    attr: Optional[str] = None  # dataclass field, when it differs from name
+
+
+def positive(v):
+    return v > 0
+
+
+def non_negative(v):
+    return v >= 0
+
+
+def one_of(*choices):
+    return lambda v: v in choices
+
+
+def in_range(lo, hi):
+    return lambda v: lo <= v <= hi
+
+
+POSITIVE = dict(check=positive, rule="must be > 0")
+NON_NEGATIVE = dict(check=non_negative, rule="must be >= 0")
+
+
+def read_yaml_file(path: str, what: str = "robot configuration") -> Any:
+    """The parsed YAML document of a file; ConfigError of one line if it cannot be read or parsed.
+
+    Bytes go to PyYAML, which decodes them (UTF-8, or UTF-16 with a byte order mark) and says where
+    decoding fails, whatever the locale.
+    """
+    try:
+        with open(path, "rb") as f:
+            return yaml.safe_load(f)
+    except OSError as e:
+        raise ConfigError(path, [Problem("", MISSING, f"cannot read the {what}: {e.strerror}")], what) from None
+    except yaml.reader.ReaderError as e:
+        if e.encoding == "unicode":
+            reason = f"character #x{e.character:04x} at offset {e.position} is not allowed in a YAML file"
+        else:
+            reason = f"byte 0x{e.character:02x} at offset {e.position} is not {e.encoding.upper()} ({e.reason})"
+        raise ConfigError(path, [Problem("", MISSING, f"not a text file: {reason}")], what) from None
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        reason = getattr(e, "problem", None) or str(e)
+        raise ConfigError(path, [Problem("", MISSING, f"not valid YAML{where}: {reason}")], what) from None
+
+
+def check_top_level(data: Any, known: Sequence[str], problems: List[Problem], ignore: Iterable[str] = ()) -> Mapping:
+    """The document as a mapping (empty for an empty file); a problem for each unknown top-level key.
+
+    Raises ConfigError at once when the document is not a mapping at all (there is nothing more to check).
+    """
+    if data is None:
+        return {}
+    if not isinstance(data, Mapping):
+        raise ConfigError(None, [Problem("", short(data), "the file must hold a mapping of keys")])
+    ignore = set(ignore)
+    for key in data:
+        if key not in known and key not in ignore:
+            problems.append(Problem(str(key), short(data[key]), unknown_key_rule(key, known)))
+    return data
+
+
+_ENTRY_NAME = re.compile(r"^([a-z_]+?)(\d+)$")
+
+
+def parse_section(
+    raw: Any, key: str, prefix: str, keys: Sequence[Key], problems: List[Problem]
+) -> List[Tuple[str, int, dict]]:
+    """(name, index, values) of each valid entry of a section, in index order.
+
+    raw: the section's value (None for an absent section); key: its top-level key, e.g.
+    ``motor_drives``; prefix: the entries' name, e.g. ``drive``.
+    """
+    if raw is None:
+        return []
+    if not isinstance(raw, Mapping):
+        problems.append(Problem(key, short(raw), f"must be a mapping of {prefix}0, {prefix}1, ..."))
+        return []
+    indexed = {}
+    for name, entry in raw.items():
+        path = f"{key}.{name}"
+        m = _ENTRY_NAME.match(str(name))
+        if not m or m.group(1) != prefix or (len(m.group(2)) > 1 and m.group(2).startswith("0")):
+            problems.append(Problem(path, MISSING, f"entries must be named {prefix}0, {prefix}1, ..."))
+            continue
+        indexed[int(m.group(2))] = (str(name), parse_entry(entry, path, keys, problems))
+    for expected, index in enumerate(sorted(indexed)):
+        if index != expected:
+            problems.append(
+                Problem(
+                    f"{key}.{prefix}{expected}",
+                    MISSING,
+                    f"entries must be numbered from {prefix}0 without gaps ({prefix}{index} is there)",
+                )
+            )
+            break
+    return [(indexed[i][0], i, indexed[i][1]) for i in sorted(indexed) if indexed[i][1] is not None]
+
+
+def parse_entry(entry: Any, path: str, keys: Sequence[Key], problems: List[Problem]) -> Optional[dict]:
+    """The entry's values with defaults filled in; None if a required key is missing or invalid.
+
+    An invalid value of a key that has a default is replaced by the default after its problem is
+    recorded, so the cross-field rules can still look at the rest of the entry.
+    """
+    if not isinstance(entry, Mapping):
+        problems.append(Problem(path, short(entry), "must be a mapping of keys"))
+        return None
+    by_name = {}
+    for key in keys:
+        by_name[key.name] = key
+        for alias in key.aliases:
+            by_name[alias] = key
+    values = {}
+    seen_as = {}
+    for raw_key, raw_value in entry.items():
+        key_path = f"{path}.{raw_key}"
+        key = by_name.get(raw_key)
+        if key is None:
+            problems.append(Problem(key_path, raw_value, unknown_key_rule(raw_key, list(by_name))))
+            continue
+        if key.name in seen_as:
+            problems.append(Problem(key_path, raw_value, f"'{raw_key}' is already given as '{seen_as[key.name]}'"))
+            continue
+        seen_as[key.name] = raw_key
+        ok, value = coerce(raw_value, key.kind)
+        if not ok:
+            problems.append(Problem(key_path, raw_value, f"must be {KIND_NAMES[key.kind]}"))
+            continue
+        if key.check is not None and value is not None and not key.check(value):
+            problems.append(Problem(key_path, raw_value, key.rule))
+            continue
+        values[key.name] = value
+    complete = True
+    for key in keys:
+        if key.name in values:
+            continue
+        if key.default is not REQUIRED:
+            values[key.name] = key.default
+            continue
+        complete = False
+        if key.name not in seen_as:
+            problems.append(Problem(f"{path}.{key.name}", MISSING, "is required"))
+    return values if complete else None
+
+
+KIND_NAMES = {float: "a finite number", int: "an integer", bool: "true or false (or 1 or 0)", str: "a string"}
+
+
+def coerce(value: Any, kind: type) -> Tuple[bool, Any]:
+    """Converts a YAML value to kind; numbers written as strings ("-0.425") count as numbers."""
+    if kind is str:
+        return (True, value) if isinstance(value, str) else (False, None)
+    if kind is bool:
+        if isinstance(value, bool):
+            return True, value
+        if isinstance(value, int) and value in (0, 1):
+            return True, bool(value)
+        if isinstance(value, str) and value.strip().lower() in ("true", "false", "0", "1"):
+            return True, value.strip().lower() in ("true", "1")
+        return False, None
+    if isinstance(value, bool):
+        return False, None
+    if isinstance(value, str):
+        try:
+            value = float(value.strip())
+        except ValueError:
+            return False, None
+    if not isinstance(value, (int, float)) or not math.isfinite(value):
+        return False, None
+    if kind is int:
+        if float(value) != int(value):
+            return False, None
+        return True, int(value)
+    return True, float(value)
+
+
+def unknown_key_rule(key: Any, known: Iterable[str]) -> str:
+    known = sorted(set(known))
+    close = difflib.get_close_matches(str(key), known, n=1, cutoff=0.6)
+    hint = f"did you mean '{close[0]}'?" if close else "known keys: {}".format(", ".join(known))
+    return f"unknown key ({hint})"
+
+
+def short(value: Any) -> Any:
+    text = repr(value)
+    return value if len(text) <= 60 else text[:57] + "..."
