@@ -84,6 +84,8 @@ class Drive:
     str_enc_ppr: int  # steering encoder pulses per motor revolution
     str_lim: float  # steering angle limit, either side of straight ahead [rad]
     str_sim_v: float  # simulated steering speed [rad/s]
+    prp_motor_torque: float  # propulsion motor torque limit [N m] (the wheel gets it times prp_gr_rt)
+    str_motor_torque: float  # steering motor torque limit [N m] (the steering gets it times str_gr_rt)
     steering_name: str  # joint name without tf_prefix, default "steeringN"
     wheel_name: str  # joint name without tf_prefix, default "wheelN"
     tower: bool  # a tower module stands above the drive (model only)
@@ -93,6 +95,16 @@ class Drive:
     @property
     def steerable(self) -> bool:
         return self.type == DRIVE_STEERED
+
+    @property
+    def max_wheel_torque(self) -> float:
+        """Torque limit at the wheel [N m]: the propulsion motor's through its gear."""
+        return self.prp_motor_torque * self.prp_gr_rt
+
+    @property
+    def max_steering_torque(self) -> float:
+        """Torque limit about the steering axis [N m]: the steering motor's through its gear."""
+        return self.str_motor_torque * self.str_gr_rt
 
     @property
     def max_steering_speed(self) -> float:
@@ -308,6 +320,11 @@ DRIVE_KEYS = (
     Key("str_enc_ppr", int, 1024, **POSITIVE),
     Key("str_lim", float, 3.078027759, lambda v: 0 < v <= math.pi, "must be in (0, pi] [rad]"),
     Key("str_sim_v", float, 4.0, aliases=("str_slm_v",), **POSITIVE),
+    # Ours: the motors' torque limits, for the simulator. About 500 W at 3000 rpm for propulsion
+    # (1.6 N m x 42 = 67 N m at the wheel, 336 N at a 0.2 m rim); 1 N m x 42.9 = 43 N m for steering,
+    # enough to turn a loaded wheel on the spot on tarmac.
+    Key("prp_motor_torque", float, 1.6, **POSITIVE),
+    Key("str_motor_torque", float, 1.0, **POSITIVE),
     Key("steering_name", str, ""),
     Key("wheel_name", str, ""),
     Key("tower", bool, True),

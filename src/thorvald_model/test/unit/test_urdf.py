@@ -229,6 +229,36 @@ def test_type1_drives_cannot_steer():
     assert js["wheel2"].get("type") == "continuous"
 
 
+def test_motor_limits_are_the_motor_torques_through_the_gears():
+    # 4wd2ws_tall: standard modules, so the defaults prp_motor_torque 1.6 N m x prp_gr_rt 42 and
+    # str_motor_torque 1.0 N m x str_gr_rt 42.8571429; a passive wheel has no motor
+    js = joints(urdf_tree(os.path.join(PKG, "config", "thorvald_ii_4wd2ws_tall", "thorvald_ii_4wd2ws_tall.yaml")))
+    assert float(js["wheel0"].find("limit").get("effort")) == pytest.approx(1.6 * 42)
+    assert float(js["steering0"].find("limit").get("effort")) == pytest.approx(1.0 * 42.8571429)
+    rwd = joints(urdf_tree(os.path.join(PKG, "config", "thorvald_ii_1wd1ws_rwd", "thorvald_ii_1wd1ws_rwd.yaml")))
+    assert float(rwd["passive0_wheel"].find("limit").get("effort")) == 0.0
+
+
+@pytest.mark.parametrize("robot", ROBOTS, ids=robot_id)
+def test_the_simulator_block_lists_every_drive_in_order(robot):
+    tree = urdf_tree(robot, "r9/")
+    plugin = tree.find("gazebo/plugin")
+    assert plugin.findtext("commandTopic") == "base_state"
+    assert plugin.findtext("odometryTopic") == "odometry/gazebo"
+    assert (plugin.findtext("odometryFrame"), plugin.findtext("robotBaseFrame")) == ("r9/odom", "r9/base_link")
+    drives = raw_yaml(robot)["motor_drives"]
+    entries = plugin.findall("drive")
+    assert [int(e.get("index")) for e in entries] == list(range(len(drives)))
+    js = joints(tree)
+    for e in entries:
+        d = drives[f"drive{e.get('index')}"]
+        assert int(e.get("type")) == int(d.get("type", 0))
+        assert float(e.get("wheel_radius")) == pytest.approx(float(d.get("r_wheel", 0.2)))
+        # the joints it names exist: the wheel turns, the steering turns unless the drive is type 1
+        assert js[e.get("wheel_joint")].get("type") == "continuous"
+        assert js[e.get("steering_joint")].get("type") == ("fixed" if e.get("type") == "1" else "revolute")
+
+
 @pytest.mark.parametrize("robot", [r for r in ROBOTS if raw_yaml(r).get("suspensions")], ids=robot_id)
 def test_suspension_is_a_damped_vertical_joint_within_its_travel(robot):
     js = joints(urdf_tree(robot))

@@ -155,8 +155,9 @@ def structural_differences(actual: ET.Element, golden: ET.Element) -> List[str]:
         out.append(f"robot name {actual.get('name')!r} != {golden.get('name')!r}")
     for tag in ("link", "joint", "material", "gazebo"):
         key = "reference" if tag == "gazebo" else "name"
-        ea = {e.get(key): e for e in actual.findall(tag)}
-        eb = {e.get(key): e for e in golden.findall(tag)}
+        # the simulator block is the one <gazebo> without a reference: keyed ""
+        ea = {e.get(key) or "": e for e in actual.findall(tag)}
+        eb = {e.get(key) or "": e for e in golden.findall(tag)}
         for name in sorted(set(ea) - set(eb)):
             out.append(f"{tag} {name!r} is new (not in the golden)")
         for name in sorted(set(eb) - set(ea)):
