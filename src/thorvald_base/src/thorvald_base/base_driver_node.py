@@ -23,6 +23,8 @@ Private parameters besides the configuration:
 ``~twist_covariance``              36 values; default diagonal 0.001 x 5, 0.03 for the yaw rate
 ``~estimator``                     odometry: ``lsq`` (default) or ``paper``
 ``~projection``                    unrealisable twists on a fixed axle: ``axle`` (default) or ``lsq``
+``~measured_timeout``              with ``base_handle: simulated_joints``: drive states older than
+                                   this stop the wheels [s] (default 0.5)
 ``~can_interface_type/name``       the CAN line of a real base
 =================================  ===========================================================
 
@@ -62,6 +64,7 @@ NODE_PARAMS = (
     "twist_covariance",
     "estimator",
     "projection",
+    "measured_timeout",
     "can_interface_type",
     "can_interface_name",
     "joint_states_remap_to",
@@ -214,9 +217,12 @@ class BaseDriverNode:
     def publish(self, result, stamp):
         # core.config, not self.config: set_drive_params may have changed r_wheel since start-up
         drives = self.core.config.drives
-        self.command_pub.publish(conversions.command_msg(stamp, drives, result.commands))
-        self.state_pub.publish(conversions.state_msg(stamp, drives, result.states, result.stopped_by == "homing"))
-        self.joint_pub.publish(conversions.joint_state_msg(stamp, self.joint_names, drives, result.states))
+        channels = [d.channel for d in drives]
+        self.command_pub.publish(
+            conversions.command_msg(stamp, result.commands, [d.max_steering_speed for d in drives], channels)
+        )
+        self.state_pub.publish(conversions.state_msg(stamp, result.states, result.stopped_by == "homing", channels))
+        self.joint_pub.publish(conversions.drive_joint_state_msg(stamp, self.joint_names, drives, result.states))
         if self.gazebo_odom is None:
             self.publish_odometry(result.odometry, stamp)
         if self._last_status_publish is None or (stamp - self._last_status_publish).to_sec() >= STATUS_PERIOD:

@@ -44,26 +44,29 @@ def joint_names(drives: Sequence, tf_prefix: str = "") -> List[str]:
     return names
 
 
-def command_msg(stamp, drives: Sequence, commands: Sequence[DriveCommand]) -> BaseState:
-    """joint_commands: what the drives were told, with each drive's steering limit and channel."""
+def command_msg(
+    stamp, commands: Sequence[DriveCommand], max_steering_speeds: Sequence[float] = (), channels: Sequence[int] = ()
+) -> BaseState:
+    """Drive commands (joint_commands, drive_commands): steering and speed per drive, with each
+    drive's steering speed limit [rad/s] and its motor channel."""
     msg = BaseState(drive_mode=BaseState.MODE_DRIVE)
     msg.header.stamp = stamp
     msg.steer_pos = [c.steering for c in commands]
     msg.prop_speed = [c.speed for c in commands]
-    msg.steer_max_speed = [d.max_steering_speed for d in drives]
-    msg.channel = [d.channel for d in drives]
+    msg.steer_max_speed = list(max_steering_speeds)
+    msg.channel = list(channels)
     return msg
 
 
-def state_msg(stamp, drives: Sequence, states: Sequence[MeasuredDrive], homing: bool = False) -> BaseState:
-    """base_state: the measured (or simulated) state of every drive."""
+def state_msg(stamp, states: Sequence[MeasuredDrive], homing: bool = False, channels: Sequence[int] = ()) -> BaseState:
+    """Measured (or simulated) drive states (base_state, drive_states)."""
     msg = BaseState(drive_mode=BaseState.MODE_HOME if homing else BaseState.MODE_DRIVE)
     msg.header.stamp = stamp
     msg.prop_speed = [s.speed for s in states]
     msg.prop_pos = [s.wheel_angle for s in states]
     msg.steer_speed = [s.steering_speed for s in states]
     msg.steer_pos = [s.steering for s in states]
-    msg.channel = [d.channel for d in drives]
+    msg.channel = list(channels)
     return msg
 
 
@@ -82,30 +85,68 @@ def measured_drives(msg: BaseState) -> List[MeasuredDrive]:
     ]
 
 
-def joint_state_msg(stamp, names: Sequence[str], drives: Sequence, states: Sequence[MeasuredDrive]) -> JointState:
-    """joint_states: per drive the steering (angle, rate) then the wheel (angle, angular speed)."""
-    msg = JointState(name=list(names))
+def joint_state_msg(stamp, names: Sequence[str], positions: Sequence[float], velocities: Sequence[float]) -> JointState:
+    msg = JointState(name=list(names), position=list(positions), velocity=list(velocities))
     msg.header.stamp = stamp
-    for d, s in zip(drives, states):
-        msg.position += [s.steering, s.wheel_angle]
-        msg.velocity += [s.steering_speed, s.speed / d.r_wheel]
     return msg
+
+
+def drive_joint_state_msg(stamp, names: Sequence[str], drives: Sequence, states: Sequence[MeasuredDrive]) -> JointState:
+    """joint_states of the drives: per drive the steering (angle, rate) then the wheel (angle, angular speed)."""
+    positions, velocities = [], []
+    for d, s in zip(drives, states):
+        positions += [s.steering, s.wheel_angle]
+        velocities += [s.steering_speed, s.speed / d.r_wheel]
+    return joint_state_msg(stamp, names, positions, velocities)
 
 
 def odometry_msg(
     stamp, odom_frame: str, base_frame: str, odometry: OdometryResult, *, pose_covariance, twist_covariance
 ) -> Odometry:
-    """odometry/base_raw: pose in odom_frame, twist in base_frame."""
+    """odometry/base_raw: the planar pose in odom_frame, the twist in base_frame."""
+    p, t = odometry.pose, odometry.twist
+    q = yaw_quaternion(p.yaw)
+    return pose_odometry_msg(
+        stamp,
+        odom_frame,
+        base_frame,
+        position=(p.x, p.y, 0.0),
+        orientation=(q.x, q.y, q.z, q.w),
+        linear=(t.vx, t.vy, 0.0),
+        angular=(0.0, 0.0, t.wz),
+        pose_covariance=pose_covariance,
+        twist_covariance=twist_covariance,
+    )
+
+
+def pose_odometry_msg(
+    stamp,
+    frame: str,
+    child_frame: str,
+    *,
+    position,
+    orientation,
+    linear,
+    angular,
+    pose_covariance=None,
+    twist_covariance=None,
+) -> Odometry:
+    """An Odometry of a full pose (position [m], quaternion x y z w) in frame and a twist (linear
+    [m/s], angular [rad/s]) in child_frame: a simulator's ground truth on any ground."""
     msg = Odometry()
     msg.header.stamp = stamp
-    msg.header.frame_id = odom_frame
-    msg.child_frame_id = base_frame
-    p, t = odometry.pose, odometry.twist
-    msg.pose.pose.position.x, msg.pose.pose.position.y = p.x, p.y
-    msg.pose.pose.orientation = yaw_quaternion(p.yaw)
-    msg.pose.covariance = list(pose_covariance)
-    msg.twist.twist.linear.x, msg.twist.twist.linear.y, msg.twist.twist.angular.z = t.vx, t.vy, t.wz
-    msg.twist.covariance = list(twist_covariance)
+    msg.header.frame_id = frame
+    msg.child_frame_id = child_frame
+    pose = msg.pose.pose
+    pose.position.x, pose.position.y, pose.position.z = position
+    pose.orientation = Quaternion(*orientation)
+    twist = msg.twist.twist
+    twist.linear.x, twist.linear.y, twist.linear.z = linear
+    twist.angular.x, twist.angular.y, twist.angular.z = angular
+    if pose_covariance is not None:
+        msg.pose.covariance = list(pose_covariance)
+    if twist_covariance is not None:
+        msg.twist.covariance = list(twist_covariance)
     return msg
 
 

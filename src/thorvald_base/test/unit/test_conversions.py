@@ -20,12 +20,22 @@ def robot(name):
 
 def test_joint_commands_carry_steering_limit_and_channel():
     diff = robot("thorvald_ii_2wd_diff")
-    msg = conversions.command_msg(STAMP, diff.drives, [DriveCommand(0.0, 0.3), DriveCommand(0.0, -0.3)])
+    msg = conversions.command_msg(
+        STAMP,
+        [DriveCommand(0.0, 0.3), DriveCommand(0.0, -0.3)],
+        [d.max_steering_speed for d in diff.drives],
+        [d.channel for d in diff.drives],
+    )
     # the two type-1 drives share node 1: channels 1 and 2; they cannot steer
     assert list(msg.channel) == [1, 2] and list(msg.steer_max_speed) == [0.0, 0.0]
     assert list(msg.prop_speed) == [0.3, -0.3] and msg.header.stamp == STAMP
     tall = robot("thorvald_ii_4wd2ws_tall")
-    msg = conversions.command_msg(STAMP, tall.drives, [DriveCommand(0.1, 0.2)] * 4)
+    msg = conversions.command_msg(
+        STAMP,
+        [DriveCommand(0.1, 0.2)] * 4,
+        [d.max_steering_speed for d in tall.drives],
+        [d.channel for d in tall.drives],
+    )
     # two steered drives (str_sim_v 4 rad/s, a controller each), two type-1 drives on one node
     assert list(msg.steer_max_speed) == [4.0, 4.0, 0.0, 0.0]
     assert list(msg.channel) == [1, 1, 1, 2]
@@ -34,8 +44,8 @@ def test_joint_commands_carry_steering_limit_and_channel():
 def test_base_state_round_trip():
     config = robot("thorvald_ii_4wd4ws_std")
     states = [MeasuredDrive(0.1 * k, 0.5, 2.0 + k, -0.2) for k in range(4)]
-    msg = conversions.state_msg(STAMP, config.drives, states, homing=True)
-    assert msg.drive_mode == msg.MODE_HOME
+    msg = conversions.state_msg(STAMP, states, homing=True, channels=[d.channel for d in config.drives])
+    assert msg.drive_mode == msg.MODE_HOME and list(msg.channel) == [1, 1, 1, 1]
     assert conversions.measured_drives(msg) == states
     msg.prop_pos = msg.prop_pos[:3]
     with pytest.raises(ValueError, match="differ in length"):
@@ -47,7 +57,7 @@ def test_joint_states_give_wheel_angular_speed():
     names = conversions.joint_names(config.drives, "robot_1/")
     assert names[:2] == ["robot_1/steering0", "robot_1/wheel0"] and len(names) == 8
     states = [MeasuredDrive(0.3, 0.5, 1.0, 0.1)] * 4
-    msg = conversions.joint_state_msg(STAMP, names, config.drives, states)
+    msg = conversions.drive_joint_state_msg(STAMP, names, config.drives, states)
     # wheel angular speed = rim speed / r_wheel = 0.5 / 0.2
     assert list(msg.position[:2]) == [0.3, 1.0] and list(msg.velocity[:2]) == [0.1, 2.5]
 
@@ -66,6 +76,20 @@ def test_odometry_and_its_transform():
     assert (tf.header.frame_id, tf.child_frame_id) == ("odom", "r/base_link")
     assert (tf.transform.translation.x, tf.transform.translation.y) == (1.0, -2.0)
     assert tf.transform.rotation == q
+
+
+def test_a_full_pose_for_ground_truth():
+    msg = conversions.pose_odometry_msg(
+        STAMP,
+        "r/odom",
+        "r/base_link",
+        position=(1.0, 2.0, 0.3),
+        orientation=(0.0, 0.0, 0.0, 1.0),
+        linear=(0.5, 0.0, 0.1),
+        angular=(0.0, 0.2, 0.3),
+    )
+    assert (msg.pose.pose.position.z, msg.twist.twist.linear.z, msg.twist.twist.angular.y) == (0.3, 0.1, 0.2)
+    assert msg.pose.pose.orientation.w == 1.0 and len(msg.pose.covariance) == 36
 
 
 def test_batteries_and_controllers():

@@ -95,7 +95,9 @@ def test_the_factory_picks_the_handle_from_the_parameters():
     assert handle_name({"simple_sim": False}) == "can"
     assert handle_name({"simple_sim": False, "base_handle": "simple_sim"}) == "simple_sim"
     assert isinstance(create_base_handle(config, {"simple_sim": True}), SimulatedBase)
-    with pytest.raises(ParameterError, match=r"~base_handle: 'warp': no such base handle; available: simple_sim$"):
+    with pytest.raises(
+        ParameterError, match=r"~base_handle: 'warp': no such base handle; available: simple_sim, simulated_joints$"
+    ):
         create_base_handle(config, {"base_handle": "warp"})
     with pytest.raises(ParameterError, match=r"'can' \(simple_sim False\).*available: simple_sim.*simple_sim:=true"):
         create_base_handle(config, {"simple_sim": False})
@@ -122,3 +124,30 @@ def test_pose_covariance_grows_per_second_of_motion():
 def test_pose_covariance_refuses_a_bad_twist_covariance(bad):
     with pytest.raises(ParameterError, match=r"~twist_covariance: .*36 finite numbers"):
         PoseCovariance(bad)
+
+
+def test_simulated_joints_send_commands_and_read_the_measured_states():
+    from thorvald_base.bases.simulated_joints import SimulatedJointsBase  # noqa: PLC0415
+
+    sent = []
+    config = four_ws()
+    base = SimulatedJointsBase(config, lambda commands, time: sent.append((time, commands)), stale_after=0.5)
+    measured = [MeasuredDrive(0.1 * k, 0.4, 1.0, 0.0) for k in range(4)]
+    base.update(measured, 10.0)
+    base.send_drive_commands([DriveCommand(0.3, 0.5)] * 4, 10.2)
+    assert sent[-1] == (10.2, tuple([DriveCommand(0.3, 0.5)] * 4))
+    assert base.read_drive_states(10.2) == measured
+    assert [c.mode for c in base.controllers(10.2)] == [3, 3, 3, 3]  # online
+    # no measurement for longer than stale_after: the simulator lost the robot; the wheels stop
+    base.send_drive_commands([DriveCommand(0.3, 0.5)] * 4, 10.6)
+    assert sent[-1] == (10.6, tuple([DriveCommand(0.3, 0.0)] * 4))
+    assert {c.mode for c in base.controllers(10.6)} == {4}  # lost connection
+    # homing: straight ahead, stopped, until a command ends it
+    base.update(measured, 10.7)
+    base.home_steering()
+    base.send_drive_commands([DriveCommand(0.3, 0.5)] * 4, 10.7)
+    assert sent[-1][1] == tuple([DriveCommand(0.0, 0.0)] * 4)
+    with pytest.raises(ValueError, match="3 drive states for 4 drives"):
+        base.update(measured[:3], 11.0)
+    base.close(11.0)
+    assert sent[-1] == (11.0, tuple([DriveCommand(0.0, 0.0)] * 4))  # the stop before closing

@@ -19,12 +19,12 @@ import os
 import re
 from typing import Any, Callable, Dict, Iterator, Optional
 
-import rospkg
 import xacro
 import yaml
 
 from .config import load_robot_config, parse_robot_config
 from .errors import ConfigError, ThorvaldModelError
+from .resources import package_folder
 
 # The package folder when this module runs from the source tree (or the devel space, which relays
 # to it); in an install space the package's files are under share/thorvald_model instead.
@@ -49,17 +49,8 @@ class RobotConfigAbort(BaseException):
 
 
 def package_file(*parts: str) -> str:
-    """A file of the thorvald_model package: where rospack finds the package (devel or install
-    space), else next to these sources (plain Python use, no ROS environment)."""
-    return os.path.join(_package_folder(os.environ.get("ROS_PACKAGE_PATH", "")), *parts)
-
-
-@functools.lru_cache(maxsize=4)
-def _package_folder(ros_package_path: str) -> str:
-    try:
-        return rospkg.RosPack().get_path("thorvald_model")
-    except rospkg.ResourceNotFound:
-        return PACKAGE_DIR
+    """A file of the thorvald_model package, in the devel or install space (or the source tree)."""
+    return os.path.join(package_folder("thorvald_model", PACKAGE_DIR), *parts)
 
 
 def xacro_file() -> str:

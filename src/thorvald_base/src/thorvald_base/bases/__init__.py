@@ -5,12 +5,15 @@ when that handle is created (as python-can's interface registry). ``~base_handle
 ``simple_sim`` when ``~simple_sim`` is true; with ``simple_sim`` false it names the CAN base,
 ``can``, which a later release registers.
 
-=============  ==============================================================================
-name           handle
-=============  ==============================================================================
-``simple_sim`` :class:`~thorvald_base.bases.simulated.SimulatedBase`: drives simulated in the
-               node, ramping at ``prp_sim_a`` and slewing at ``str_sim_v``
-=============  ==============================================================================
+====================  =======================================================================
+name                  handle
+====================  =======================================================================
+``simple_sim``        :class:`~thorvald_base.bases.simulated.SimulatedBase`: drives simulated in
+                      the node, ramping at ``prp_sim_a`` and slewing at ``str_sim_v``
+``simulated_joints``  :class:`~thorvald_base.bases.simulated_joints.SimulatedJointsBase`: drives
+                      measured from a physics simulator's joints (``drive_commands`` out,
+                      ``drive_states`` in; ``~measured_timeout``, 0.5 s)
+====================  =======================================================================
 """
 
 import importlib
@@ -21,6 +24,7 @@ from .handle import BaseHandle, BatteryInfo, ControllerInfo, MeasuredDrive
 
 BASE_HANDLES: Dict[str, str] = {
     "simple_sim": "thorvald_base.bases.simulated:SimulatedBase",
+    "simulated_joints": "thorvald_base.bases.simulated_joints:SimulatedJointsBase",
 }
 
 

@@ -1,0 +1,147 @@
+"""What the simulator reads from a robot description (URDF), without pybullet or ROS.
+
+From the generator's simulator block (``<gazebo><plugin>``, as the original generator emitted it for
+its Gazebo plugin): the command and odometry topics, the odometry and base frames, and one
+``<drive>`` per drive in drive order (steering joint, wheel joint, wheel radius). From the joints:
+the motors' limits (``<limit effort velocity>``), the suspension springs (``<springStiffness>`` in
+the joint's ``<gazebo reference>`` and the joint's damping) and the passive joints (casters, support
+wheels) with their friction. A URDF without the block (any other robot) is a passive model.
+"""
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from typing import Dict, Optional, Tuple
+
+
+class DescriptionError(Exception):
+    """A robot description the simulator cannot use; the message says why."""
+
+
+@dataclass(frozen=True)
+class JointInfo:
+    name: str
+    type: str  # URDF joint type
+    effort: float  # [N m] or [N]; 0 when the URDF gives none
+    velocity: float  # [rad/s] or [m/s]; 0 when the URDF gives none
+    damping: float  # [N m s/rad] or [N s/m]
+    friction: float  # [N m] or [N]
+
+
+@dataclass(frozen=True)
+class DriveJoints:
+    """One drive of the simulator block: the joints base_state's entry of index ``index`` moves."""
+
+    index: int
+    steerable: bool  # type 0; a type-1 drive's steering joint is fixed
+    steering_joint: str
+    wheel_joint: str
+    wheel_radius: float  # [m]
+
+
+@dataclass(frozen=True)
+class Spring:
+    """A sprung suspension joint: force -stiffness (q - reference) - damping q' along the joint."""
+
+    joint: str
+    stiffness: float  # [N/m]
+    damping: float  # [N s/m]
+    reference: float = 0.0  # [m]
+
+
+@dataclass(frozen=True)
+class RobotDescription:
+    name: str
+    joints: Dict[str, JointInfo]
+    drives: Tuple[DriveJoints, ...]  # empty: a passive model
+    springs: Tuple[Spring, ...]
+    command_topic: str = "base_state"
+    odometry_topic: str = "odometry/gazebo"
+    odometry_frame: str = "odom"
+    base_frame: str = "base_link"
+
+    @property
+    def passive_joints(self) -> Tuple[JointInfo, ...]:
+        """Moving joints no motor drives and no spring holds: casters, support wheels."""
+        driven = {d.wheel_joint for d in self.drives} | {d.steering_joint for d in self.drives if d.steerable}
+        sprung = {s.joint for s in self.springs}
+        return tuple(
+            j for j in self.joints.values() if j.type != "fixed" and j.name not in driven and j.name not in sprung
+        )
+
+
+def _float(text: Optional[str], what: str) -> float:
+    try:
+        return float(text) if text not in (None, "") else 0.0
+    except ValueError:
+        raise DescriptionError(f"{what}: {text!r} is not a number") from None
+
+
+def parse_description(xml: str) -> RobotDescription:
+    """The simulator's view of a URDF; DescriptionError saying why it cannot be used."""
+    if not xml or not xml.strip():
+        raise DescriptionError("the robot description is empty")
+    try:
+        root = ET.fromstring(xml)
+    except ET.ParseError as e:
+        raise DescriptionError(f"the robot description is not valid XML ({e})") from None
+    if root.tag != "robot":
+        raise DescriptionError(f"the robot description's root element is <{root.tag}>, not <robot>")
+    if root.find("link") is None:
+        raise DescriptionError("the robot description has no <link>")
+    joints = {}
+    for j in root.findall("joint"):
+        name = j.get("name")
+        limit = j.find("limit")
+        dynamics = j.find("dynamics")
+        joints[name] = JointInfo(
+            name,
+            j.get("type", ""),
+            _float(limit.get("effort") if limit is not None else None, f"joint {name} effort"),
+            _float(limit.get("velocity") if limit is not None else None, f"joint {name} velocity"),
+            _float(dynamics.get("damping") if dynamics is not None else None, f"joint {name} damping"),
+            _float(dynamics.get("friction") if dynamics is not None else None, f"joint {name} friction"),
+        )
+    springs = []
+    for g in root.findall("gazebo"):
+        stiffness = g.findtext("springStiffness")
+        ref = g.get("reference")
+        if stiffness is not None and ref in joints:
+            springs.append(
+                Spring(
+                    ref,
+                    _float(stiffness, f"joint {ref} springStiffness"),
+                    joints[ref].damping,
+                    _float(g.findtext("springReference"), f"joint {ref} springReference"),
+                )
+            )
+    plugin = next((p for g in root.findall("gazebo") for p in g.findall("plugin") if p.findall("drive")), None)
+    if plugin is None:
+        return RobotDescription(root.get("name", ""), joints, (), tuple(springs))
+    drives = []
+    for k, e in enumerate(plugin.findall("drive")):
+        index = int(_float(e.get("index"), "drive index"))
+        if index != k:
+            raise DescriptionError(f"the simulator block's drives are not in order: drive {index} comes {k}th")
+        drive = DriveJoints(
+            index,
+            e.get("type", "0") == "0",
+            e.get("steering_joint", ""),
+            e.get("wheel_joint", ""),
+            _float(e.get("wheel_radius"), f"drive {index} wheel_radius"),
+        )
+        for joint in (drive.wheel_joint, drive.steering_joint):
+            if joint not in joints:
+                raise DescriptionError(f"drive {index} names joint {joint!r}, which the description does not have")
+        if drive.wheel_radius <= 0:
+            raise DescriptionError(f"drive {index}: wheel_radius must be > 0")
+        drives.append(drive)
+    return RobotDescription(
+        root.get("name", ""),
+        joints,
+        tuple(drives),
+        tuple(springs),
+        plugin.findtext("commandTopic") or "base_state",
+        plugin.findtext("odometryTopic") or "odometry/gazebo",
+        plugin.findtext("odometryFrame") or "odom",
+        plugin.findtext("robotBaseFrame") or "base_link",
+    )

@@ -1,0 +1,248 @@
+"""One robot in a pybullet world: loaded from its URDF, driven by torque-limited motors, measured.
+
+No ROS here: the simulator node converts messages. The pybullet client id is passed in.
+
+* Loading: ``URDF_USE_INERTIA_FROM_FILE`` (masses and inertias from the URDF),
+  ``URDF_USE_IMPLICIT_CYLINDER`` (wheels roll as true cylinders, at exactly r omega),
+  ``URDF_MERGE_FIXED_LINKS`` (the frame's fixed modules become one rigid body: about three times
+  faster to step, and nothing of the frame moves anyway).
+* Motors (the URDF's limits, which the generator derives from the configuration): each steering
+  joint is a position servo with the joint's effort as torque limit and the commanded (or the
+  joint's) speed limit; each wheel a velocity motor with the joint's effort as torque limit. The
+  URDF's joint damping and friction are the original's figures for Gazebo's synchronising plugin;
+  on motors they would fight the torque limits (and explicit damping of 100 N m s/rad on a
+  0.12 kg m^2 wheel is unstable at 240 Hz), so driven joints get none.
+* Suspension joints are springs and dampers (``<springStiffness>`` and the joint's damping),
+  applied every step. Passive joints (casters, support wheels) turn freely against their URDF
+  friction.
+* Every link has lateral friction 1.0, so a contact's friction (pybullet multiplies the two
+  bodies') is the world surface's, and no velocity damping (pybullet's default drag of 0.04 /s).
+* Ground truth is base_link's pose and twist: pybullet reports the base's centre of mass, so the
+  URDF's inertial offset (all merged modules' centre of mass) is composed out.
+"""
+
+import contextlib
+import math
+import os
+import sys
+import tempfile
+from dataclasses import dataclass
+from typing import List, Optional, Sequence, Tuple
+
+import pybullet as p
+
+from thorvald_base.bases import MeasuredDrive
+
+from .description import DescriptionError, RobotDescription
+
+LOAD_FLAGS = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER | p.URDF_MERGE_FIXED_LINKS
+LINK_FRICTION = 1.0
+STEERING_POSITION_GAIN = 0.5  # pybullet's servo gain: fraction of the position error closed per step
+
+
+@dataclass(frozen=True)
+class Pose2D:
+    """A spawn pose: base_link at (x, y, z) [m] turned by yaw [rad]."""
+
+    x: float = 0.0
+    y: float = 0.0
+    z: float = 0.0
+    yaw: float = 0.0
+
+
+Vec3 = Tuple[float, float, float]
+Quat = Tuple[float, float, float, float]
+
+
+class SimRobot:
+    def __init__(self, client: int, name: str, description: RobotDescription, urdf: str, pose: Pose2D):
+        self.client = client
+        self.name = name
+        self.description = description
+        self.spawn_pose = pose
+        with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
+            f.write(urdf)
+        try:
+            orientation = p.getQuaternionFromEuler((0.0, 0.0, pose.yaw))
+            with _quiet_stdout():
+                self.body = p.loadURDF(
+                    f.name, (pose.x, pose.y, pose.z), orientation, flags=LOAD_FLAGS, physicsClientId=client
+                )
+        except p.error as e:
+            raise DescriptionError(f"pybullet cannot load the description ({e})") from None
+        finally:
+            os.unlink(f.name)
+        self.joint_index = {}
+        for j in range(p.getNumJoints(self.body, physicsClientId=client)):
+            self.joint_index[p.getJointInfo(self.body, j, physicsClientId=client)[1].decode()] = j
+        dyn = p.getDynamicsInfo(self.body, -1, physicsClientId=client)
+        self._inertial = (tuple(dyn[3]), tuple(dyn[4]))  # centre of mass in base_link
+        self._to_base_link = p.invertTransform(*self._inertial)
+        self._setup_joints()
+        self._odom = ((pose.x, pose.y, 0.0), p.getQuaternionFromEuler((0.0, 0.0, pose.yaw)))
+        self._odom_inverse = p.invertTransform(*self._odom)
+
+    # ---- set-up ---------------------------------------------------------------------------
+    def _setup_joints(self) -> None:
+        c, body, d = self.client, self.body, self.description
+        for link in range(-1, p.getNumJoints(body, physicsClientId=c)):
+            # pybullet gives every body a velocity damping of 0.04 /s, a drag no robot has
+            p.changeDynamics(
+                body, link, lateralFriction=LINK_FRICTION, linearDamping=0.0, angularDamping=0.0, physicsClientId=c
+            )
+        self.steering = []  # (joint index, effort, velocity limit) per drive; None for type 1
+        self.wheels = []  # (joint index, effort, radius) per drive
+        for drive in d.drives:
+            w = d.joints[drive.wheel_joint]
+            self.wheels.append((self._index(drive.wheel_joint), w.effort, drive.wheel_radius))
+            if drive.steerable:
+                s = d.joints[drive.steering_joint]
+                self.steering.append((self._index(drive.steering_joint), s.effort, s.velocity))
+            else:
+                self.steering.append(None)
+        motors = [w[0] for w in self.wheels] + [s[0] for s in self.steering if s is not None]
+        self.springs = [(self._index(s.joint), s) for s in d.springs if s.joint in self.joint_index]
+        for j in motors + [j for j, _ in self.springs]:
+            p.changeDynamics(body, j, jointDamping=0.0, physicsClientId=c)
+        for j, _ in self.springs:
+            p.setJointMotorControl2(body, j, p.VELOCITY_CONTROL, force=0.0, physicsClientId=c)
+        self.passive = [(self._index(j.name), j) for j in d.passive_joints if j.name in self.joint_index]
+        for j, info in self.passive:
+            p.setJointMotorControl2(
+                body, j, p.VELOCITY_CONTROL, targetVelocity=0.0, force=info.friction, physicsClientId=c
+            )
+        self.hold()
+
+    def _index(self, joint: str) -> int:
+        if joint not in self.joint_index:
+            raise DescriptionError(f"joint {joint!r} is not a moving joint of the loaded robot")
+        return self.joint_index[joint]
+
+    # ---- commands -------------------------------------------------------------------------
+    def command(
+        self,
+        steering: Sequence[float],
+        speeds: Sequence[float],
+        max_steering_speeds: Optional[Sequence[float]] = None,
+    ) -> None:
+        """Steering positions [rad] and wheel rim speeds [m/s], one per drive in drive order.
+
+        max_steering_speeds [rad/s]: the steering's speed limit per drive (a BaseState's
+        steer_max_speed); 0 or absent takes the joint's limit from the URDF.
+        """
+        n = len(self.wheels)
+        if len(steering) != n or len(speeds) != n:
+            raise ValueError(f"{self.name}: {n} drives, got {len(steering)} steering and {len(speeds)} speed values")
+        c, body = self.client, self.body
+        for k in range(n):
+            wheel, effort, radius = self.wheels[k]
+            p.setJointMotorControl2(
+                body, wheel, p.VELOCITY_CONTROL, targetVelocity=speeds[k] / radius, force=effort, physicsClientId=c
+            )
+            if self.steering[k] is None:
+                continue
+            joint, effort, limit = self.steering[k]
+            speed = max_steering_speeds[k] if max_steering_speeds and max_steering_speeds[k] > 0 else limit
+            p.setJointMotorControl2(
+                body,
+                joint,
+                p.POSITION_CONTROL,
+                targetPosition=steering[k],
+                force=effort,
+                maxVelocity=speed if speed > 0 else 100.0,
+                positionGain=STEERING_POSITION_GAIN,
+                physicsClientId=c,
+            )
+
+    def hold(self) -> None:
+        """Wheels stopped (their motors brake), steering held where it is."""
+        states = self.drive_states()
+        self.command([s.steering for s in states], [0.0] * len(states))
+
+    def apply_springs(self) -> None:
+        """The suspension's spring and damper forces for the next step (called before every step)."""
+        if not self.springs:
+            return
+        c, body = self.client, self.body
+        joints = [j for j, _ in self.springs]
+        states = p.getJointStates(body, joints, physicsClientId=c)
+        forces = [-s.stiffness * (q[0] - s.reference) - s.damping * q[1] for (_, s), q in zip(self.springs, states)]
+        p.setJointMotorControlArray(body, joints, p.TORQUE_CONTROL, forces=forces, physicsClientId=c)
+
+    # ---- measurements -------------------------------------------------------------------------
+    def drive_states(self) -> List[MeasuredDrive]:
+        """What each drive's encoders measure: steering angle and rate, wheel angle and rim speed."""
+        c, body = self.client, self.body
+        out = []
+        for (wheel, _, radius), steer in zip(self.wheels, self.steering):
+            w = p.getJointState(body, wheel, physicsClientId=c)
+            s = p.getJointState(body, steer[0], physicsClientId=c) if steer is not None else (0.0, 0.0)
+            out.append(MeasuredDrive(s[0], w[1] * radius, w[0], s[1]))
+        return out
+
+    def joint_states(self, joints: Sequence[int]) -> List[Tuple[float, float]]:
+        """(position, velocity) of the given joint indices."""
+        return [tuple(s[:2]) for s in p.getJointStates(self.body, list(joints), physicsClientId=self.client)]
+
+    def world_pose(self) -> Tuple[Vec3, Quat]:
+        """base_link in the world."""
+        com, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
+        pos, quat = p.multiplyTransforms(com, orn, *self._to_base_link)
+        return tuple(pos), tuple(quat)
+
+    def odom_pose(self) -> Tuple[Vec3, Quat]:
+        """base_link in the robot's odom frame, which is the spawn pose on the ground."""
+        pos, quat = p.multiplyTransforms(*self._odom_inverse, *self.world_pose())
+        return tuple(pos), tuple(quat)
+
+    def body_twist(self) -> Tuple[Vec3, Vec3]:
+        """base_link's linear [m/s] and angular [rad/s] velocity, in base_link."""
+        c = self.client
+        com, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=c)
+        v, w = p.getBaseVelocity(self.body, physicsClientId=c)
+        origin, _ = p.multiplyTransforms(com, orn, *self._to_base_link)
+        r = [origin[i] - com[i] for i in range(3)]
+        # the velocity of base_link's origin: v_com + w x r
+        v_origin = (
+            v[0] + w[1] * r[2] - w[2] * r[1],
+            v[1] + w[2] * r[0] - w[0] * r[2],
+            v[2] + w[0] * r[1] - w[1] * r[0],
+        )
+        inverse = p.invertTransform((0.0, 0.0, 0.0), orn)
+        lin, _ = p.multiplyTransforms(*inverse, v_origin, (0.0, 0.0, 0.0, 1.0))
+        ang, _ = p.multiplyTransforms(*inverse, w, (0.0, 0.0, 0.0, 1.0))
+        return tuple(lin), tuple(ang)
+
+    # ---- life -------------------------------------------------------------------------------
+    def reset(self) -> None:
+        """Back to the spawn pose, at rest, joints at 0, wheels stopped."""
+        c, pose = self.client, self.spawn_pose
+        link = ((pose.x, pose.y, pose.z), p.getQuaternionFromEuler((0.0, 0.0, pose.yaw)))
+        com, orn = p.multiplyTransforms(*link, *self._inertial)
+        p.resetBasePositionAndOrientation(self.body, com, orn, physicsClientId=c)
+        p.resetBaseVelocity(self.body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=c)
+        for j in self.joint_index.values():
+            p.resetJointState(self.body, j, 0.0, 0.0, physicsClientId=c)
+        self.hold()
+
+    def remove(self) -> None:
+        p.removeBody(self.body, physicsClientId=self.client)
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """pybullet's C++ logs every merged link on file descriptor 1: silence it while loading."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def yaw_of(quat: Quat) -> float:
+    x, y, z, w = quat
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))

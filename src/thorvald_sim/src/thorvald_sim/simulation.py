@@ -1,0 +1,105 @@
+"""A pybullet world with its robots and its clock, without ROS (the simulator node wraps it).
+
+The pybullet client is passed in (``pybullet.connect(pybullet.DIRECT)`` or ``GUI``); this module
+never connects. Time is the simulated time [s], advanced by one physics step of 1 / physics_rate.
+"""
+
+from dataclasses import dataclass
+from typing import Dict, Tuple
+
+import numpy as np
+import pybullet as p
+
+from .description import DescriptionError, parse_description
+from .robot import Pose2D, SimRobot
+from .scene import build_scene
+from .world import WorldConfig
+
+SOLVER_ITERATIONS = 50  # pybullet's default, named so the benchmark's raw stepping uses the same
+
+
+class SpawnError(Exception):
+    """A robot that cannot be spawned (or deleted); the message says why."""
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A camera pose for snapshots: from eye [m] towards target [m], z up."""
+
+    eye: Tuple[float, float, float] = (6.0, -6.0, 5.0)
+    target: Tuple[float, float, float] = (0.0, 0.0, 0.3)
+    width: int = 960  # [px]
+    height: int = 640  # [px]
+    fov: float = 50.0  # vertical field of view [deg]
+
+
+class Simulation:
+    def __init__(self, client: int, world: WorldConfig, physics_rate: float = 240.0):
+        if not physics_rate > 0:
+            raise ValueError(f"physics_rate: {physics_rate!r}: must be > 0 [Hz]")
+        self.client = client
+        self.dt = 1.0 / physics_rate
+        p.setPhysicsEngineParameter(
+            fixedTimeStep=self.dt, numSolverIterations=SOLVER_ITERATIONS, physicsClientId=client
+        )
+        self.scene = build_scene(client, world)
+        self.robots: Dict[str, SimRobot] = {}
+        self.time = 0.0  # [s] simulated
+        self.steps = 0
+
+    def spawn(self, name: str, urdf: str, pose: Pose2D) -> SimRobot:
+        """Loads a robot; SpawnError (the world unchanged) if the name is taken or the URDF unusable."""
+        if not name:
+            raise SpawnError("a robot needs a name")
+        if name in self.robots:
+            raise SpawnError(f"a robot named {name!r} exists already")
+        try:
+            robot = SimRobot(self.client, name, parse_description(urdf), urdf, pose)
+        except DescriptionError as e:
+            raise SpawnError(f"{name}: {e}") from None
+        self.robots[name] = robot
+        return robot
+
+    def delete(self, name: str) -> None:
+        robot = self.robots.pop(name, None)
+        if robot is None:
+            raise SpawnError(f"no robot named {name!r}; robots: {', '.join(sorted(self.robots)) or 'none'}")
+        robot.remove()
+
+    def step(self) -> None:
+        """One physics step of dt: the suspensions' spring forces, then the solver."""
+        for robot in self.robots.values():
+            robot.apply_springs()
+        p.stepSimulation(physicsClientId=self.client)
+        self.steps += 1
+        self.time = self.steps * self.dt
+
+    def reset(self) -> None:
+        """Every robot back to its spawn pose, at rest. Time keeps running (nodes dislike a clock that jumps back)."""
+        for robot in self.robots.values():
+            robot.reset()
+
+    def render(self, camera: Camera = Camera()):
+        """An RGB image (numpy uint8, height x width x 3) from pybullet's software renderer: no display needed."""
+        view = p.computeViewMatrix(camera.eye, camera.target, (0.0, 0.0, 1.0), physicsClientId=self.client)
+        projection = p.computeProjectionMatrixFOV(
+            camera.fov, camera.width / camera.height, 0.05, 100.0, physicsClientId=self.client
+        )
+        _, _, rgba, _, _ = p.getCameraImage(
+            camera.width,
+            camera.height,
+            view,
+            projection,
+            renderer=p.ER_TINY_RENDERER,
+            shadow=1,
+            lightDirection=(2.0, -1.0, 4.0),
+            physicsClientId=self.client,
+        )
+        return np.asarray(rgba, dtype=np.uint8).reshape(camera.height, camera.width, 4)[:, :, :3]
+
+
+def save_png(image, path: str) -> None:
+    """Writes an RGB image (numpy, height x width x 3) as PNG."""
+    from PIL import Image  # noqa: PLC0415  (only when a snapshot is taken)
+
+    Image.fromarray(image, "RGB").save(path)

@@ -1,0 +1,341 @@
+"""The ``simulator`` node: one pybullet world, the clock, and per robot the original Gazebo plugin's topics.
+
+Private parameters:
+
+========================  ================================================================
+``~world``                a shipped world's name (``flat``, ``tarmac_gravel``, ``slope``,
+                          ``greenhouse``) or a world file (default ``flat``)
+``~gui``                  open pybullet's window (default false: headless)
+``~physics_rate``         physics steps per simulated second [Hz] (240)
+``~real_time_factor``     simulated seconds per wall second (1); 0 runs as fast as it can
+``~clock_rate``           /clock messages per simulated second [Hz] (200; at most one a step)
+``~odometry_rate``        odometry/gazebo and joint_states per simulated second [Hz] (50)
+``~drive_state_rate``     drive_states per simulated second [Hz] (100)
+``~command_timeout``      a robot whose commands stop for this long [s] stops its wheels (0.5)
+``~publish_tf``           default for robots: tf odom -> base_link from ground truth (false)
+``~paused``               start paused (false)
+========================  ================================================================
+
+Per robot, in its namespace: subscribes the command topic (``base_state``, as the original plugin,
+or base_driver's ``drive_commands`` with measured drives); publishes ``odometry/gazebo``
+(nav_msgs/Odometry: ``<tf_prefix>odom`` at the spawn pose -> ``<tf_prefix>base_link``, the twist in
+base_link), ``joint_states`` of the joints base_driver does not report (casters, support wheels,
+suspension) and ``drive_states`` (thorvald_msgs/BaseState: what each drive's encoders measure).
+
+Services: ``~pause``, ``~unpause``, ``~reset`` (std_srvs/Empty, as Gazebo's), ``~spawn_robot``,
+``~delete_robot``, ``~snapshot`` (thorvald_msgs). The node publishes ``/clock``, so everything with
+``/use_sim_time`` runs on simulated time; its own pacing is on the wall clock.
+"""
+
+import math
+import os
+import sys
+import tempfile
+import threading
+import time
+
+import pybullet as p
+import rospy
+import tf2_ros
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_srvs.srv import Empty, EmptyResponse
+
+from thorvald_base import conversions
+from thorvald_model import ConfigError
+from thorvald_msgs.msg import BaseState
+from thorvald_msgs.srv import (
+    DeleteRobot,
+    DeleteRobotResponse,
+    Snapshot,
+    SnapshotResponse,
+    SpawnRobot,
+    SpawnRobotResponse,
+)
+
+from .robot import Pose2D
+from .simulation import Camera, Simulation, SpawnError, save_png
+from .world import load_world, resolve_world
+
+WARN_PERIOD = 5.0  # [s] between repeats of one warning
+EXIT_REFUSED = 1
+
+
+class ParameterError(Exception):
+    pass
+
+
+def positive(name: str, default: float, allow_zero: bool = False) -> float:
+    value = rospy.get_param("~" + name, default)
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"~{name}: {value!r}: must be a number") from None
+    if not math.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
+        raise ParameterError(f"~{name}: {value!r}: must be {'>= 0' if allow_zero else '> 0'}")
+    return value
+
+
+class Every:
+    """True once per period of simulated time [s] (0: every call)."""
+
+    def __init__(self, rate: float):
+        self.period = 1.0 / rate if rate > 0 else 0.0
+        self.next = 0.0
+
+    def due(self, now: float) -> bool:
+        if now + 1e-9 < self.next:
+            return False
+        self.next = now + self.period if self.period else now
+        return True
+
+
+class RobotIO:
+    """The ROS side of one simulated robot."""
+
+    def __init__(self, node, robot, namespace: str, command_topic: str, publish_tf: bool):
+        self.robot = robot
+        d = robot.description
+        ns = namespace.rstrip("/") + "/" if namespace else "/"
+        self.namespace = ns
+        self.publish_tf = publish_tf
+        self.odom_pub = rospy.Publisher(ns + d.odometry_topic, Odometry, queue_size=10)
+        self.joint_pub = rospy.Publisher(ns + "joint_states", JointState, queue_size=10)
+        self.drive_pub = rospy.Publisher(ns + "drive_states", BaseState, queue_size=10)
+        self.lock = threading.Lock()
+        self.command = None  # the latest (steering, speeds, max steering speeds), to apply in the loop
+        self.command_time = None  # [s] simulated time it arrived
+        self.fresh = False
+        self.node = node
+        self.sub = rospy.Subscriber(ns + command_topic, BaseState, self.on_command, queue_size=1)
+        self.passive = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
+        self.passive_names = [info.name for _, info in robot.passive] + [s.joint for _, s in robot.springs]
+
+    def on_command(self, msg):
+        n = len(self.robot.wheels)
+        if len(msg.steer_pos) != n or len(msg.prop_speed) != n:
+            rospy.logwarn_throttle(
+                WARN_PERIOD,
+                "simulator: %s: a command for %d/%d drives ignored; the robot has %d",
+                self.robot.name,
+                len(msg.steer_pos),
+                len(msg.prop_speed),
+                n,
+            )
+            return
+        values = list(msg.steer_pos) + list(msg.prop_speed) + list(msg.steer_max_speed)
+        if not all(math.isfinite(v) for v in values):
+            rospy.logwarn_throttle(WARN_PERIOD, "simulator: %s: a non-finite command ignored", self.robot.name)
+            return
+        limits = list(msg.steer_max_speed) if len(msg.steer_max_speed) == n else None
+        with self.lock:
+            self.command = (list(msg.steer_pos), list(msg.prop_speed), limits)
+            self.command_time = self.node.sim.time
+            self.fresh = True
+
+    def apply(self, now: float, timeout: float) -> None:
+        """In the loop, before a step: the latest command, or a stop if commands stopped coming."""
+        with self.lock:
+            command, fresh, since = self.command, self.fresh, self.command_time
+            self.fresh = False
+        if fresh:
+            self.robot.command(*command)
+        elif since is not None and now - since > timeout:
+            self.robot.hold()
+            with self.lock:
+                if self.command_time == since:
+                    self.command_time = None
+
+    def publish_odometry(self, stamp, tf):
+        d = self.robot.description
+        position, orientation = self.robot.odom_pose()
+        linear, angular = self.robot.body_twist()
+        msg = conversions.pose_odometry_msg(
+            stamp,
+            d.odometry_frame,
+            d.base_frame,
+            position=position,
+            orientation=orientation,
+            linear=linear,
+            angular=angular,
+        )
+        self.odom_pub.publish(msg)
+        if self.publish_tf:
+            tf.sendTransform(conversions.odometry_transform(msg))
+        if self.passive:
+            states = self.robot.joint_states(self.passive)
+            self.joint_pub.publish(
+                conversions.joint_state_msg(stamp, self.passive_names, [s[0] for s in states], [s[1] for s in states])
+            )
+
+    def publish_drives(self, stamp):
+        self.drive_pub.publish(conversions.state_msg(stamp, self.robot.drive_states()))
+
+    def close(self):
+        self.sub.unregister()
+        for pub in (self.odom_pub, self.joint_pub, self.drive_pub):
+            pub.unregister()
+
+
+class SimulatorNode:
+    def __init__(self):
+        world_name = str(rospy.get_param("~world", "flat"))
+        world = load_world(resolve_world(world_name))
+        self.gui = bool(rospy.get_param("~gui", False))
+        physics_rate = positive("physics_rate", 240.0)
+        self.real_time_factor = positive("real_time_factor", 1.0, allow_zero=True)
+        clock_rate = positive("clock_rate", 200.0)
+        odometry_rate = positive("odometry_rate", 50.0)
+        drive_state_rate = positive("drive_state_rate", 100.0)
+        self.command_timeout = positive("command_timeout", 0.5)
+        self.default_tf = bool(rospy.get_param("~publish_tf", False))
+        self.paused = bool(rospy.get_param("~paused", False))
+        self.client = p.connect(p.GUI if self.gui else p.DIRECT)
+        self.sim = Simulation(self.client, world, physics_rate)
+        self.lock = threading.RLock()
+        self.io = {}
+        self.clock = Every(clock_rate)
+        self.odometry = Every(odometry_rate)
+        self.drives = Every(drive_state_rate)
+        self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10)
+        self.tf = tf2_ros.TransformBroadcaster()
+        rospy.Service("~pause", Empty, self.srv_pause)
+        rospy.Service("~unpause", Empty, self.srv_unpause)
+        rospy.Service("~reset", Empty, self.srv_reset)
+        rospy.Service("~spawn_robot", SpawnRobot, self.srv_spawn)
+        rospy.Service("~delete_robot", DeleteRobot, self.srv_delete)
+        rospy.Service("~snapshot", Snapshot, self.srv_snapshot)
+        self.publish_clock()
+        rospy.loginfo(
+            "simulator: world %s (%s), %.0f Hz physics, real-time factor %s%s",
+            world_name,
+            world.source,
+            physics_rate,
+            self.real_time_factor or "as fast as possible",
+            ", paused" if self.paused else "",
+        )
+
+    # ---- services -------------------------------------------------------------------------
+    def srv_pause(self, _req):
+        with self.lock:
+            self.paused = True
+        return EmptyResponse()
+
+    def srv_unpause(self, _req):
+        with self.lock:
+            self.paused = False
+        return EmptyResponse()
+
+    def srv_reset(self, _req):
+        with self.lock:
+            self.sim.reset()
+        rospy.loginfo("simulator: robots back at their spawn poses")
+        return EmptyResponse()
+
+    def srv_spawn(self, req):
+        pose = Pose2D(req.x, req.y, req.z, req.yaw)
+        if not all(math.isfinite(v) for v in (req.x, req.y, req.z, req.yaw)):
+            return SpawnRobotResponse(False, f"{req.model_name}: the spawn pose must be finite")
+        with self.lock:
+            try:
+                robot = self.sim.spawn(req.model_name, req.robot_description, pose)
+            except SpawnError as e:
+                rospy.logerr("simulator: refused to spawn: %s", e)
+                return SpawnRobotResponse(False, str(e))
+            topic = req.command_topic or robot.description.command_topic
+            tf = self.default_tf if req.publish_tf < 0 else bool(req.publish_tf)
+            self.io[req.model_name] = RobotIO(self, robot, req.robot_namespace, topic, tf)
+        kind = f"{len(robot.wheels)} drives following {topic}" if robot.wheels else "passive (no drive block)"
+        message = f"spawned {req.model_name} in {req.robot_namespace or '/'} at ({req.x:g}, {req.y:g}), {kind}"
+        rospy.loginfo("simulator: %s", message)
+        return SpawnRobotResponse(True, message)
+
+    def srv_delete(self, req):
+        with self.lock:
+            try:
+                self.sim.delete(req.model_name)
+            except SpawnError as e:
+                return DeleteRobotResponse(False, str(e))
+            self.io.pop(req.model_name).close()
+        return DeleteRobotResponse(True, f"deleted {req.model_name}")
+
+    def srv_snapshot(self, req):
+        camera = Camera()
+        for name in ("eye", "target"):
+            values = tuple(getattr(req, name))
+            if values:
+                if len(values) != 3 or not all(math.isfinite(v) for v in values):
+                    return SnapshotResponse(False, f"{name} must be 3 finite numbers [m]", "")
+                camera = Camera(**{**camera.__dict__, name: values})
+        if req.width or req.height:
+            camera = Camera(camera.eye, camera.target, req.width or camera.width, req.height or camera.height)
+        path = req.path or tempfile.mkstemp(prefix="thorvald_sim_", suffix=".png")[1]
+        with self.lock:
+            image = self.sim.render(camera)
+        try:
+            save_png(image, path)
+        except OSError as e:
+            return SnapshotResponse(False, f"{path}: {e.strerror}", "")
+        return SnapshotResponse(True, f"{camera.width} x {camera.height} px", os.path.abspath(path))
+
+    # ---- the loop ---------------------------------------------------------------------------
+    def publish_clock(self):
+        self.clock_pub.publish(Clock(clock=rospy.Time.from_sec(self.sim.time)))
+
+    def spin(self):
+        anchor = None  # (wall, simulated) times from which real-time pacing counts
+        while not rospy.is_shutdown():
+            with self.lock:
+                paused = self.paused
+                if not paused:
+                    now = self.sim.time
+                    for io in self.io.values():
+                        io.apply(now, self.command_timeout)
+                    self.sim.step()
+                    self.publish(self.sim.time)
+            if paused:
+                anchor = None
+                time.sleep(0.01)
+                continue
+            if self.real_time_factor > 0:
+                wall = time.monotonic()
+                if anchor is None:
+                    anchor = (wall, self.sim.time)
+                ahead = anchor[0] + (self.sim.time - anchor[1]) / self.real_time_factor - wall
+                if ahead > 0:
+                    time.sleep(ahead)
+                elif ahead < -0.5:
+                    anchor = None  # too slow to keep up: do not race to catch up afterwards
+
+    def publish(self, now: float):
+        stamp = rospy.Time.from_sec(now)
+        if self.clock.due(now):
+            self.publish_clock()
+        if self.odometry.due(now):
+            for io in self.io.values():
+                io.publish_odometry(stamp, self.tf)
+        if self.drives.due(now):
+            for io in self.io.values():
+                io.publish_drives(stamp)
+
+    def shutdown(self):
+        with self.lock:
+            if p.isConnected(self.client):
+                p.disconnect(self.client)
+
+
+def main():
+    rospy.init_node("simulator")
+    try:
+        node = SimulatorNode()
+    except (ConfigError, ParameterError) as e:
+        rospy.logfatal("simulator: refusing to start: %s", e)
+        sys.exit(EXIT_REFUSED)
+    except p.error as e:
+        rospy.logfatal("simulator: refusing to start: pybullet: %s", e)
+        sys.exit(EXIT_REFUSED)
+    try:
+        node.spin()
+    finally:
+        node.shutdown()
