@@ -92,6 +92,10 @@ def test_code_and_package_files_come_from_the_install_space(install):
         "share/thorvald_model/rviz/model.rviz",
         "share/thorvald_bringup/launch/twist_mux.launch",
         "share/thorvald_bringup/config/twist_mux.yaml",
+        "lib/thorvald_sim/simulator",
+        "lib/thorvald_sim/spawn_robot",
+        "share/thorvald_sim/launch/robot.launch",
+        "share/thorvald_sim/worlds/tarmac_gravel.yaml",
     ):
         assert os.path.exists(os.path.join(install, path)), path
 

@@ -153,9 +153,18 @@ class BadConfigTest(unittest.TestCase):
             self.assertTrue(received, "no odometry from base_driver on the good file")
         finally:
             sub.unregister()
-            if proc.poll() is None:
-                os.killpg(proc.pid, signal.SIGINT)
-            proc.communicate(timeout=20)
+            self.stop(proc)
+
+    def stop(self, proc):
+        """SIGINT, as roslaunch does; a node that is still running 30 s later fails the test, with its output."""
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGINT)
+        try:
+            proc.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            out, err = proc.communicate(timeout=10)
+            self.fail(f"base_driver did not exit within 30 s of SIGINT:\n{out}\n{err}")
 
 
 if __name__ == "__main__":

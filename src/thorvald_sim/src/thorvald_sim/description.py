@@ -10,7 +10,7 @@ wheels) with their friction. A URDF without the block (any other robot) is a pas
 
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Dict, Optional, Tuple
+from typing import Dict, Iterable, Optional, Tuple
 
 
 class DescriptionError(Exception):
@@ -36,6 +36,7 @@ class DriveJoints:
     steering_joint: str
     wheel_joint: str
     wheel_radius: float  # [m]
+    max_acceleration: float = 0.0  # the drive controller's rim acceleration limit [m/s^2]; 0: none
 
 
 @dataclass(frozen=True)
@@ -128,6 +129,7 @@ def parse_description(xml: str) -> RobotDescription:
             e.get("steering_joint", ""),
             e.get("wheel_joint", ""),
             _float(e.get("wheel_radius"), f"drive {index} wheel_radius"),
+            _float(e.get("max_acceleration"), f"drive {index} max_acceleration"),
         )
         for joint in (drive.wheel_joint, drive.steering_joint):
             if joint not in joints:
@@ -145,3 +147,24 @@ def parse_description(xml: str) -> RobotDescription:
         plugin.findtext("odometryFrame") or "odom",
         plugin.findtext("robotBaseFrame") or "base_link",
     )
+
+
+def with_tyre_contact(xml: str, wheel_joints: Iterable[str], fraction: float) -> str:
+    """The URDF with the collision cylinders of the given wheels' links narrowed to fraction of their width.
+
+    A crowned tyre touches the ground over a short, narrow patch; a flat cylinder of the wheel's
+    full width touches along its whole width and scrubs far more whenever the wheel turns about its
+    vertical axis (a robot spinning on the spot walks a few centimetres a turn). The visual shapes,
+    masses and inertias stay as they are.
+    """
+    if fraction == 1.0:
+        return xml
+    root = ET.fromstring(xml)
+    joints = set(wheel_joints)
+    wheel_links = {j.find("child").get("link") for j in root.findall("joint") if j.get("name") in joints}
+    for link in root.findall("link"):
+        if link.get("name") not in wheel_links:
+            continue
+        for cylinder in link.findall("collision/geometry/cylinder"):
+            cylinder.set("length", repr(float(cylinder.get("length")) * fraction))
+    return ET.tostring(root, encoding="unicode")

@@ -12,6 +12,9 @@ No ROS here: the simulator node converts messages. The pybullet client id is pas
   URDF's joint damping and friction are the original's figures for Gazebo's synchronising plugin;
   on motors they would fight the torque limits (and explicit damping of 100 N m s/rad on a
   0.12 kg m^2 wheel is unstable at 240 Hz), so driven joints get none.
+* Tyres touch the ground over half their width (``TYRE_CONTACT_FRACTION``): the wheels' collision
+  cylinders are narrowed when the robot is loaded, as a crowned tyre's patch is narrow; a flat
+  cylinder of the full width scrubs a spinning robot several centimetres off its spot.
 * Suspension joints are springs and dampers (``<springStiffness>`` and the joint's damping),
   applied every step. Passive joints (casters, support wheels) turn freely against their URDF
   friction.
@@ -33,11 +36,13 @@ import pybullet as p
 
 from thorvald_base.bases import MeasuredDrive
 
-from .description import DescriptionError, RobotDescription
+from .description import DescriptionError, RobotDescription, with_tyre_contact
 
 LOAD_FLAGS = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER | p.URDF_MERGE_FIXED_LINKS
 LINK_FRICTION = 1.0
 STEERING_POSITION_GAIN = 0.5  # pybullet's servo gain: fraction of the position error closed per step
+TYRE_CONTACT_FRACTION = 0.5  # of a wheel's width that touches the ground (see with_tyre_contact)
+FOLLOW_HEADROOM = 2.0  # following states, the steering servo may turn this much faster than the drive
 
 
 @dataclass(frozen=True)
@@ -55,13 +60,24 @@ Quat = Tuple[float, float, float, float]
 
 
 class SimRobot:
-    def __init__(self, client: int, name: str, description: RobotDescription, urdf: str, pose: Pose2D):
+    def __init__(
+        self,
+        client: int,
+        name: str,
+        description: RobotDescription,
+        urdf: str,
+        pose: Pose2D,
+        *,
+        tyre_contact_fraction: float = TYRE_CONTACT_FRACTION,
+    ):
         self.client = client
         self.name = name
         self.description = description
         self.spawn_pose = pose
+        wheels = [d.wheel_joint for d in description.drives]
+        wheels += [j.name for j in description.passive_joints if j.name.endswith("wheel")]
         with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
-            f.write(urdf)
+            f.write(with_tyre_contact(urdf, wheels, tyre_contact_fraction))
         try:
             orientation = p.getQuaternionFromEuler((0.0, 0.0, pose.yaw))
             with _quiet_stdout():
@@ -92,6 +108,9 @@ class SimRobot:
             )
         self.steering = []  # (joint index, effort, velocity limit) per drive; None for type 1
         self.wheels = []  # (joint index, effort, radius) per drive
+        self.accelerations = [drive.max_acceleration for drive in d.drives]  # [m/s^2]
+        self._target = [0.0] * len(d.drives)  # commanded rim speeds [m/s]
+        self._speed = [0.0] * len(d.drives)  # the wheels' motor targets on their way there [m/s]
         for drive in d.drives:
             w = d.joints[drive.wheel_joint]
             self.wheels.append((self._index(drive.wheel_joint), w.effort, drive.wheel_radius))
@@ -127,22 +146,29 @@ class SimRobot:
     ) -> None:
         """Steering positions [rad] and wheel rim speeds [m/s], one per drive in drive order.
 
-        max_steering_speeds [rad/s]: the steering's speed limit per drive (a BaseState's
-        steer_max_speed); 0 or absent takes the joint's limit from the URDF.
+        Commands and states differ: a command (base_driver's drive_commands) carries the steering's
+        speed limit per drive in max_steering_speeds [rad/s], and its wheel speeds are reached as a
+        drive controller reaches them, ramping at the drive's max_acceleration. States to follow
+        (base_state, without limits) slew and ramp within the drives' limits already: their wheel
+        speeds apply at once, and the steering servo gets FOLLOW_HEADROOM times the joint's limit
+        to catch up the stream's latency instead of trailing it through every slew.
         """
         n = len(self.wheels)
         if len(steering) != n or len(speeds) != n:
             raise ValueError(f"{self.name}: {n} drives, got {len(steering)} steering and {len(speeds)} speed values")
         c, body = self.client, self.body
+        ramped = bool(max_steering_speeds)
         for k in range(n):
-            wheel, effort, radius = self.wheels[k]
-            p.setJointMotorControl2(
-                body, wheel, p.VELOCITY_CONTROL, targetVelocity=speeds[k] / radius, force=effort, physicsClientId=c
-            )
+            self._target[k] = speeds[k]
+            if not ramped or self.accelerations[k] <= 0:
+                self._set_wheel(k, speeds[k])
             if self.steering[k] is None:
                 continue
             joint, effort, limit = self.steering[k]
-            speed = max_steering_speeds[k] if max_steering_speeds and max_steering_speeds[k] > 0 else limit
+            if max_steering_speeds and max_steering_speeds[k] > 0:
+                speed = max_steering_speeds[k]
+            else:
+                speed = FOLLOW_HEADROOM * limit
             p.setJointMotorControl2(
                 body,
                 joint,
@@ -153,6 +179,26 @@ class SimRobot:
                 positionGain=STEERING_POSITION_GAIN,
                 physicsClientId=c,
             )
+
+    def _set_wheel(self, k: int, speed: float) -> None:
+        wheel, effort, radius = self.wheels[k]
+        self._speed[k] = speed
+        p.setJointMotorControl2(
+            self.body,
+            wheel,
+            p.VELOCITY_CONTROL,
+            targetVelocity=speed / radius,
+            force=effort,
+            physicsClientId=self.client,
+        )
+
+    def before_step(self, dt: float) -> None:
+        """Called before every physics step of dt [s]: wheels ramp towards commanded speeds, springs push."""
+        for k, (target, now) in enumerate(zip(self._target, self._speed)):
+            if target != now:
+                step = self.accelerations[k] * dt
+                self._set_wheel(k, target if abs(target - now) <= step else now + (step if target > now else -step))
+        self.apply_springs()
 
     def hold(self) -> None:
         """Wheels stopped (their motors brake), steering held where it is."""

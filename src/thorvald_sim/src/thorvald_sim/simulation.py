@@ -11,7 +11,7 @@ import numpy as np
 import pybullet as p
 
 from .description import DescriptionError, parse_description
-from .robot import Pose2D, SimRobot
+from .robot import TYRE_CONTACT_FRACTION, Pose2D, SimRobot
 from .scene import build_scene
 from .world import WorldConfig
 
@@ -34,9 +34,18 @@ class Camera:
 
 
 class Simulation:
-    def __init__(self, client: int, world: WorldConfig, physics_rate: float = 240.0):
+    def __init__(
+        self,
+        client: int,
+        world: WorldConfig,
+        physics_rate: float = 240.0,
+        tyre_contact_fraction: float = TYRE_CONTACT_FRACTION,
+    ):
         if not physics_rate > 0:
             raise ValueError(f"physics_rate: {physics_rate!r}: must be > 0 [Hz]")
+        if not 0.0 < tyre_contact_fraction <= 1.0:
+            raise ValueError(f"tyre_contact_fraction: {tyre_contact_fraction!r}: must be in (0, 1]")
+        self.tyre_contact_fraction = tyre_contact_fraction
         self.client = client
         self.dt = 1.0 / physics_rate
         p.setPhysicsEngineParameter(
@@ -54,7 +63,9 @@ class Simulation:
         if name in self.robots:
             raise SpawnError(f"a robot named {name!r} exists already")
         try:
-            robot = SimRobot(self.client, name, parse_description(urdf), urdf, pose)
+            robot = SimRobot(
+                self.client, name, parse_description(urdf), urdf, pose, tyre_contact_fraction=self.tyre_contact_fraction
+            )
         except DescriptionError as e:
             raise SpawnError(f"{name}: {e}") from None
         self.robots[name] = robot
@@ -67,9 +78,9 @@ class Simulation:
         robot.remove()
 
     def step(self) -> None:
-        """One physics step of dt: the suspensions' spring forces, then the solver."""
+        """One physics step of dt: the wheels' ramps and the suspensions' springs, then the solver."""
         for robot in self.robots.values():
-            robot.apply_springs()
+            robot.before_step(self.dt)
         p.stepSimulation(physicsClientId=self.client)
         self.steps += 1
         self.time = self.steps * self.dt

