@@ -252,10 +252,12 @@ class BaseDriverNode:
             self.tf.sendTransform(conversions.odometry_transform(msg))
 
     def shutdown(self):
-        """rospy's shutdown hook: the drives get a zero-speed command before the handle is closed."""
+        """rospy's shutdown hook: the drives get a zero-speed command before the handle is closed.
+
+        Nothing is logged here: a log message goes out on /rosout while rospy closes its publishers.
+        """
         with self.lock:
             self.core.shutdown(rospy.get_time())
-        rospy.loginfo("base_driver: wheels stopped, base closed")
 
 
 def main():

@@ -38,6 +38,7 @@ def start_driver(name, robot_file, **node_params):
     rospy.set_param("/" + name, params)
     return subprocess.Popen(
         ["rosrun", "thorvald_base", "base_driver", "__name:=" + name],
+        env=dict(os.environ, PYTHONFAULTHANDLER="1"),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         universal_newlines=True,
@@ -65,6 +66,7 @@ def start_driver_on_file(name, robot_file):
             "_robot_model:=" + robot_file,
             "_simple_sim:=true",
         ],
+        env=dict(os.environ, PYTHONFAULTHANDLER="1"),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         universal_newlines=True,
@@ -162,9 +164,14 @@ class BadConfigTest(unittest.TestCase):
         try:
             proc.communicate(timeout=30)
         except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-            out, err = proc.communicate(timeout=10)
-            self.fail(f"base_driver did not exit within 30 s of SIGINT:\n{out}\n{err}")
+            # faulthandler (PYTHONFAULTHANDLER) prints every thread's stack on SIGABRT
+            os.killpg(proc.pid, signal.SIGABRT)
+            try:
+                out, err = proc.communicate(timeout=10)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                out, err = proc.communicate(timeout=10)
+            self.fail(f"base_driver did not exit within 30 s of SIGINT; its threads:\n{out}\n{err}")
 
 
 if __name__ == "__main__":

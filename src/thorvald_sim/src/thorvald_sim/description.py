@@ -149,16 +149,15 @@ def parse_description(xml: str) -> RobotDescription:
     )
 
 
-def with_tyre_contact(xml: str, wheel_joints: Iterable[str], fraction: float) -> str:
-    """The URDF with the collision cylinders of the given wheels' links narrowed to fraction of their width.
+def with_tyre_contact(xml: str, wheel_joints: Iterable[str], width: float) -> str:
+    """The URDF with the collision cylinders of the given wheels' links narrowed to width [m].
 
-    A crowned tyre touches the ground over a short, narrow patch; a flat cylinder of the wheel's
-    full width touches along its whole width and scrubs far more whenever the wheel turns about its
-    vertical axis (a robot spinning on the spot walks a few centimetres a turn). The visual shapes,
-    masses and inertias stay as they are.
+    pybullet touches a cylinder lying on a plane at one rim, not across its width, so a wheel's
+    contact lies half its collision width beside the wheel's centre line: 8 cm for a 0.16 m wheel,
+    enough to turn a differential robot's arcs 3 % tight and walk a spinning robot off its spot. A
+    thin disc puts the contact within width / 2 of the centre line, where a crowned tyre's patch
+    is. The visual shapes, masses and inertias stay as they are.
     """
-    if fraction == 1.0:
-        return xml
     root = ET.fromstring(xml)
     joints = set(wheel_joints)
     wheel_links = {j.find("child").get("link") for j in root.findall("joint") if j.get("name") in joints}
@@ -166,5 +165,5 @@ def with_tyre_contact(xml: str, wheel_joints: Iterable[str], fraction: float) ->
         if link.get("name") not in wheel_links:
             continue
         for cylinder in link.findall("collision/geometry/cylinder"):
-            cylinder.set("length", repr(float(cylinder.get("length")) * fraction))
+            cylinder.set("length", repr(min(float(cylinder.get("length")), width)))
     return ET.tostring(root, encoding="unicode")

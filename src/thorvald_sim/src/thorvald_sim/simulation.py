@@ -11,7 +11,7 @@ import numpy as np
 import pybullet as p
 
 from .description import DescriptionError, parse_description
-from .robot import TYRE_CONTACT_FRACTION, Pose2D, SimRobot
+from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
 from .scene import build_scene
 from .world import WorldConfig
 
@@ -39,13 +39,13 @@ class Simulation:
         client: int,
         world: WorldConfig,
         physics_rate: float = 240.0,
-        tyre_contact_fraction: float = TYRE_CONTACT_FRACTION,
+        tyre_contact_width: float = TYRE_CONTACT_WIDTH,
     ):
         if not physics_rate > 0:
             raise ValueError(f"physics_rate: {physics_rate!r}: must be > 0 [Hz]")
-        if not 0.0 < tyre_contact_fraction <= 1.0:
-            raise ValueError(f"tyre_contact_fraction: {tyre_contact_fraction!r}: must be in (0, 1]")
-        self.tyre_contact_fraction = tyre_contact_fraction
+        if not tyre_contact_width > 0.0:
+            raise ValueError(f"tyre_contact_width: {tyre_contact_width!r}: must be > 0 [m]")
+        self.tyre_contact_width = tyre_contact_width
         self.client = client
         self.dt = 1.0 / physics_rate
         p.setPhysicsEngineParameter(
@@ -64,7 +64,7 @@ class Simulation:
             raise SpawnError(f"a robot named {name!r} exists already")
         try:
             robot = SimRobot(
-                self.client, name, parse_description(urdf), urdf, pose, tyre_contact_fraction=self.tyre_contact_fraction
+                self.client, name, parse_description(urdf), urdf, pose, tyre_contact_width=self.tyre_contact_width
             )
         except DescriptionError as e:
             raise SpawnError(f"{name}: {e}") from None

@@ -16,7 +16,7 @@ Private parameters:
                           simulated time [s] (0.05; 0: never): a busy machine slows the
                           simulation instead of letting robots drive on stale commands
 ``~publish_tf``           default for robots: tf odom -> base_link from ground truth (false)
-``~tyre_contact_fraction`` of a wheel's width that touches the ground (0.5: a crowned tyre)
+``~tyre_contact_width``   width of the wheels' collision discs [m] (0.01; see robot.py)
 ``~paused``               start paused (false)
 ========================  ================================================================
 
@@ -207,9 +207,7 @@ class SimulatorNode:
         self.command_timeout = positive("command_timeout", 0.5)
         self.max_lag = positive("max_lag", 0.05, allow_zero=True)
         self.default_tf = bool(rospy.get_param("~publish_tf", False))
-        tyre = positive("tyre_contact_fraction", 0.5)
-        if tyre > 1.0:
-            raise ParameterError(f"~tyre_contact_fraction: {tyre!r}: must be in (0, 1]")
+        tyre = positive("tyre_contact_width", 0.01)
         self.paused = bool(rospy.get_param("~paused", False))
         self.client = p.connect(p.GUI if self.gui else p.DIRECT)
         self.sim = Simulation(self.client, world, physics_rate, tyre)

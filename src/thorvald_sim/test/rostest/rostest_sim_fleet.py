@@ -44,6 +44,7 @@ class SimFleetTest(unittest.TestCase):
             "broken", "/broken", "<robot name='broken'><link name='a'/><joint", 9.0, 9.0, 0.0, 0.0, "", -1
         )
         cls.mid = {r: planar(cls.truth[r].get()) for r in cls.robots}
+        cls.mid_twist = {r: cls.truth[r].get().twist.twist for r in cls.robots}
         sim_sleep(SECONDS / 2)
         for r in ("diff", "rwd", "nine"):
             cls.nav[r].send()
@@ -56,34 +57,39 @@ class SimFleetTest(unittest.TestCase):
         (truth0, odom0), (truth1, odom1) = self.start[robot], self.end[robot]
         return delta(truth0, truth1), delta(odom0, odom1)
 
-    def check_arc(self, robot):
+    def check_arc(self, robot, radius):
+        """The turn and the path that base_driver's drive states describe, and, mid-arc, base_link
+        turning about the centre of rotation the command gives, radius [m] away."""
         truth, odom = self.motion(robot)
+        t = self.mid_twist[robot]
+        measured = math.hypot(t.linear.x, t.linear.y) / t.angular.z
         rospy.loginfo(
-            "%s arc: ground truth %.4f m chord, %.4f rad; odometry %.4f rad", robot, truth[0], truth[2], odom[2]
+            "%s arc: ground truth %.4f m chord, %.4f rad, radius %.4f m; odometry %.4f m chord, %.4f rad",
+            robot,
+            truth[0],
+            truth[2],
+            measured,
+            odom[0],
+            odom[2],
         )
-        # the turn base_driver's drive states describe, and the arc of the radius the command gives
-        # base_link: its centre of rotation is on the axle at vx / wz from the x axis
+        self.assertGreater(odom[2], WZ * SECONDS * 0.6)  # it turned (a busy machine may start it late)
         self.assertAlmostEqual(truth[2], odom[2], delta=0.03 * abs(odom[2]))
-        self.assertGreater(odom[2], WZ * SECONDS * 0.8)
-        return truth
+        self.assertAlmostEqual(truth[0], odom[0], delta=0.03 * odom[0])
+        self.assertAlmostEqual(measured, radius, delta=0.03 * radius)
 
     def test_the_differential_robot_follows_its_arc(self):
-        truth = self.check_arc("diff")
-        # axle through base_link: base_link's circle has radius vx / wz; chord = 2 R sin(turn / 2)
-        radius = VX / WZ
-        self.assertAlmostEqual(truth[0], 2 * radius * math.sin(truth[2] / 2), delta=0.03 * truth[0])
+        # axle through base_link: base_link turns about (0, vx / wz)
+        self.check_arc("diff", VX / WZ)
 
     def test_the_one_wheel_drive_robot_follows_its_arc(self):
-        truth = self.check_arc("rwd")
-        # support wheels' axle at x = 0.45: the centre of rotation (0.45, vx / wz), base_link's
-        # circle through the origin has the radius of the distance to it
-        radius = math.hypot(0.45, VX / WZ)
-        self.assertAlmostEqual(truth[0], 2 * radius * math.sin(truth[2] / 2), delta=0.03 * truth[0])
+        # support wheels' axle at x = 0.45: the centre of rotation (0.45, vx / wz), base_link at the
+        # distance to it
+        self.check_arc("rwd", math.hypot(0.45, VX / WZ))
 
     def test_the_nine_wheel_robot_drives_straight(self):
         truth, odom = self.motion("nine")
         rospy.loginfo("nine straight: ground truth %.4f m, odometry %.4f m", truth[0], odom[0])
-        self.assertGreater(odom[0], 0.5 * SECONDS * 0.9)
+        self.assertGreater(odom[0], 0.5 * SECONDS * 0.6)  # it drove
         self.assertAlmostEqual(truth[0], odom[0], delta=0.02 * odom[0])
         self.assertAlmostEqual(truth[1], 0.0, delta=0.02)
 

@@ -138,10 +138,43 @@ def test_spin_in_place_about_base_link(sim):
     (x0, y0, _), q0 = robot.odom_pose()
     run(sim, 2.0, robot, steering, speeds)
     (x1, y1, _), q1 = robot.odom_pose()
-    assert robot.body_twist()[1][2] == pytest.approx(wz, rel=0.02)  # the tyres scrub a little
+    assert robot.body_twist()[1][2] == pytest.approx(wz, rel=0.01)
     assert math.hypot(x1 - x0, y1 - y0) < 0.05
     turned = math.remainder(yaw_of(q1) - yaw_of(q0), 2 * math.pi)
     assert turned == pytest.approx(wz * 2.0, rel=0.03)
+
+
+def test_a_differential_robot_turns_about_the_point_its_wheel_speeds_give(sim):
+    """v_right, v_left = vx -+ wz b: base_link turns about (0, vx / wz). The wheels must touch the
+    ground under their centre lines for that (pybullet touches a wide cylinder at one rim)."""
+    config = load_robot_config(example("thorvald_ii_2wd_diff"))
+    robot = sim.spawn("r", urdf(example("thorvald_ii_2wd_diff")), Pose2D())
+    run(sim, 0.5)
+    vx, wz = 0.4, 0.3
+    run(sim, 3.0, robot, [0.0, 0.0], [vx - wz * d.y for d in config.drives])
+    v, w = robot.body_twist()
+    assert w[2] == pytest.approx(wz, rel=0.01)
+    assert math.hypot(v[0], v[1]) / w[2] == pytest.approx(vx / wz, rel=0.01)
+
+
+def test_the_wheels_touch_the_ground_with_thin_discs():
+    from thorvald_sim.description import with_tyre_contact  # noqa: PLC0415
+
+    xml = urdf(example("thorvald_ii_2wd_diff"))
+    thin = with_tyre_contact(xml, ["wheel0", "passive0_wheel"], 0.01)
+    import xml.etree.ElementTree as ET  # noqa: PLC0415
+
+    def widths(text, link):
+        root = ET.fromstring(text)
+        element = next(e for e in root.findall("link") if e.get("name") == link)
+        return [float(c.get("length")) for c in element.findall("collision/geometry/cylinder")], [
+            float(c.get("length")) for c in element.findall("visual/geometry/cylinder")
+        ]
+
+    # collision narrowed to 1 cm, the visual as the URDF draws it; a wheel not named stays whole
+    assert widths(thin, "wheel0_link") == ([0.01, 0.01], [0.16, 0.164])
+    assert widths(thin, "passive0_wheel_link")[0] == [0.01, 0.01]
+    assert widths(thin, "wheel1_link") == widths(xml, "wheel1_link")
 
 
 def test_wheels_are_torque_limited(sim):

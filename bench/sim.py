@@ -1,0 +1,219 @@
+#!/usr/bin/env python3
+"""The simulator's speed against raw pybullet, side by side in one run, for 1, 4 and 9 robots.
+
+    python bench/sim.py [--seconds S] [--robots 1 4 9]
+
+Raw: pybullet alone (no ROS, no Python between steps) loads the standard robot's URDF N times with
+the simulator's settings (merged fixed links, half-width tyre contact, no joint damping on the
+motors), sets its wheels to 0.5 m/s once and steps at 240 Hz. Node: the simulator node on a master
+of its own, N robots through robot.launch (base_driver, twist_mux, robot_state_publisher each),
+driven at 0.5 m/s through twist_mux, the simulator as fast as it can (real_time_factor 0; it waits
+for robots whose commands lag, ~max_lag).
+
+Figures: real-time factor (simulated seconds per wall second); CPU of the stepping process per
+simulated second (the simulator node's own overhead against raw stepping: target at most 1.25);
+CPU of every node together. Target: four robots at least 3 times real time on this 2-core machine.
+"""
+
+import argparse
+import os
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
+STD = os.path.join(ROOT, "src", "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
+SPACING = 4.0  # [m] between robots
+TICK = os.sysconf("SC_CLK_TCK")
+TARGET_OVERHEAD = 1.25
+TARGET_FOUR = 3.0
+
+
+def grid(k):
+    return SPACING * (k % 3), SPACING * (k // 3)
+
+
+def raw(n: int, seconds: float):
+    """(real-time factor, CPU [s] per simulated second) of pybullet stepping n robots."""
+    import pybullet as p  # noqa: PLC0415
+
+    from thorvald_model.description import generate_urdf  # noqa: PLC0415
+    from thorvald_sim import robot as simrobot  # noqa: PLC0415
+    from thorvald_sim.description import parse_description, with_tyre_contact  # noqa: PLC0415
+    from thorvald_sim.simulation import SOLVER_ITERATIONS  # noqa: PLC0415
+
+    urdf = generate_urdf(STD)
+    d = parse_description(urdf)
+    urdf = with_tyre_contact(urdf, [x.wheel_joint for x in d.drives], simrobot.TYRE_CONTACT_WIDTH)
+    with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
+        f.write(urdf)
+    c = p.connect(p.DIRECT)
+    try:
+        p.setPhysicsEngineParameter(fixedTimeStep=1 / 240, numSolverIterations=SOLVER_ITERATIONS, physicsClientId=c)
+        p.setGravity(0, 0, -9.81, physicsClientId=c)
+        plane = p.createMultiBody(0, p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c), physicsClientId=c)
+        p.changeDynamics(plane, -1, lateralFriction=0.9, physicsClientId=c)
+        for k in range(n):
+            x, y = grid(k)
+            with simrobot._quiet_stdout():
+                body = p.loadURDF(f.name, (x, y, 0.0), flags=simrobot.LOAD_FLAGS, physicsClientId=c)
+            for j in range(p.getNumJoints(body, physicsClientId=c)):
+                name = p.getJointInfo(body, j, physicsClientId=c)[1].decode()
+                p.changeDynamics(body, j, jointDamping=0.0, lateralFriction=1.0, physicsClientId=c)
+                if name.startswith("wheel"):
+                    p.setJointMotorControl2(
+                        body, j, p.VELOCITY_CONTROL, targetVelocity=2.5, force=67.2, physicsClientId=c
+                    )
+                else:
+                    p.setJointMotorControl2(
+                        body, j, p.POSITION_CONTROL, targetPosition=0.0, force=42.9, physicsClientId=c
+                    )
+        steps = round(seconds * 240)
+        wall, cpu = time.perf_counter(), time.process_time()
+        for _ in range(steps):
+            p.stepSimulation(physicsClientId=c)
+        wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    finally:
+        p.disconnect(c)
+        os.unlink(f.name)
+    return seconds / wall, cpu / seconds
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def cpu_seconds(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / TICK
+    except OSError:
+        return 0.0
+
+
+def pids(pattern):
+    out = subprocess.run(["pgrep", "-f", pattern], capture_output=True, text=True).stdout.split()
+    return [int(x) for x in out]
+
+
+def node(n: int, seconds: float):
+    """(real-time factor, simulator CPU [s] per simulated second, all nodes' CPU share [cores])."""
+    port = free_port()
+    env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
+    robots = "\n".join(
+        f'  <include file="$(find thorvald_sim)/launch/robot.launch"><arg name="robot_name" value="r{k}"/>'
+        f'<arg name="x" value="{grid(k)[0]}"/><arg name="y" value="{grid(k)[1]}"/></include>'
+        for k in range(n)
+    )
+    launch = tempfile.NamedTemporaryFile("w", suffix=".launch", delete=False)
+    launch.write(
+        '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'
+        '<arg name="real_time_factor" value="0"/><arg name="output" value="log"/></include>\n'
+        f"{robots}\n</launch>\n"
+    )
+    launch.close()
+    proc = subprocess.Popen(
+        ["roslaunch", "-p", str(port), launch.name],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    try:
+        os.environ["ROS_MASTER_URI"] = env["ROS_MASTER_URI"]
+        import rospy  # noqa: PLC0415
+        from geometry_msgs.msg import Twist  # noqa: PLC0415
+        from rosgraph_msgs.msg import Clock  # noqa: PLC0415
+
+        if not rospy.core.is_initialized():
+            rospy.init_node("bench_sim", anonymous=True, disable_signals=True)
+        clock = {"t": None}
+        sub = rospy.Subscriber("/clock", Clock, lambda m: clock.__setitem__("t", m.clock.to_sec()))
+        pubs = [rospy.Publisher(f"/r{k}/nav_vel", Twist, queue_size=1) for k in range(n)]
+        twist = Twist()
+        twist.linear.x = 0.5
+        stop = threading.Event()
+
+        def drive():  # faster than any mux timeout at any real-time factor reached here
+            while not stop.is_set():
+                for pub in pubs:
+                    pub.publish(twist)
+                time.sleep(0.01)
+
+        threading.Thread(target=drive, daemon=True).start()
+        deadline = time.time() + 120 + 15 * n
+        while time.time() < deadline and (clock["t"] is None or sum(p.get_num_connections() for p in pubs) < n):
+            time.sleep(0.2)
+        time.sleep(3.0)  # spawned and driving
+        simulator = pids("thorvald_sim/simulator") + pids("nodes/simulator")
+        every = [
+            int(x)
+            for x in subprocess.run(["pgrep", "-g", str(proc.pid)], capture_output=True, text=True).stdout.split()
+        ]
+        t0, w0 = clock["t"], time.perf_counter()
+        c0 = sum(cpu_seconds(p) for p in simulator)
+        a0 = sum(cpu_seconds(p) for p in every)
+        while clock["t"] - t0 < seconds and time.perf_counter() - w0 < 20 * seconds:
+            time.sleep(0.1)
+        t1, w1 = clock["t"], time.perf_counter()
+        c1 = sum(cpu_seconds(p) for p in simulator)
+        a1 = sum(cpu_seconds(p) for p in every)
+        stop.set()
+        sub.unregister()
+        for pub in pubs:
+            pub.unregister()
+        simulated = t1 - t0
+        return simulated / (w1 - w0), (c1 - c0) / simulated, (a1 - a0) / (w1 - w0)
+    finally:
+        os.killpg(proc.pid, signal.SIGINT)
+        try:
+            proc.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+        os.unlink(launch.name)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--seconds", type=float, default=20.0, help="simulated seconds measured per case")
+    parser.add_argument("--robots", type=int, nargs="+", default=[1, 4, 9])
+    args = parser.parse_args()
+    print(
+        f"{'robots':>6} {'raw RTF':>8} {'node RTF':>9} {'raw CPU/s':>10} {'node CPU/s':>11} {'overhead':>9}"
+        f" {'all nodes':>10}"
+    )
+    results = {}
+    for n in args.robots:
+        raw_rtf, raw_cpu = raw(n, args.seconds)
+        node_rtf, node_cpu, all_cpu = node(n, args.seconds)
+        results[n] = (raw_rtf, node_rtf, raw_cpu, node_cpu)
+        print(
+            f"{n:>6} {raw_rtf:>7.1f}x {node_rtf:>8.1f}x {raw_cpu:>9.3f}s {node_cpu:>10.3f}s"
+            f" {node_cpu / raw_cpu:>8.2f}x {all_cpu:>7.2f} cores",
+            flush=True,
+        )
+    ok = True
+    worst = max(results[n][3] / results[n][2] for n in results)
+    verdict = worst <= TARGET_OVERHEAD
+    ok &= verdict
+    print(
+        f"\ntarget: the simulator node's CPU per simulated second at most {TARGET_OVERHEAD} x raw stepping's: "
+        f"{'met' if verdict else 'MISSED'} (worst {worst:.2f} x)"
+    )
+    if 4 in results:
+        verdict = results[4][1] >= TARGET_FOUR
+        ok &= verdict
+        figure = f"{results[4][1]:.1f} x"
+        print(f"target: 4 robots at least {TARGET_FOUR:g} x real time: {'met' if verdict else 'MISSED'} ({figure})")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
