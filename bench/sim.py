@@ -4,15 +4,16 @@
     python bench/sim.py [--seconds S] [--robots 1 4 9]
 
 Raw: pybullet alone (no ROS, no Python between steps) loads the standard robot's URDF N times with
-the simulator's settings (merged fixed links, half-width tyre contact, no joint damping on the
-motors), sets its wheels to 0.5 m/s once and steps at 240 Hz. Node: the simulator node on a master
-of its own, N robots through robot.launch (base_driver, twist_mux, robot_state_publisher each),
-driven at 0.5 m/s through twist_mux, the simulator as fast as it can (real_time_factor 0; it waits
-for robots whose commands lag, ~max_lag).
+the simulator's settings (merged fixed links, thin tyre contact discs, no joint damping on the
+motors), sets its wheels to 0.5 m/s once and steps at 240 Hz. Core: the simulator's own
+Simulation class (ramps, springs, Python between steps) stepping the same robots, no ROS. Node:
+the simulator node on the benchmark's master, N robots through robot.launch (base_driver,
+twist_mux, robot_state_publisher each), driven at 0.5 m/s through twist_mux, the simulator as fast
+as it can (real_time_factor 0; it waits for robots whose commands lag, ~max_lag).
 
 Figures: real-time factor (simulated seconds per wall second); CPU of the stepping process per
-simulated second (the simulator node's own overhead against raw stepping: target at most 1.25);
-CPU of every node together. Target: four robots at least 3 times real time on this 2-core machine.
+simulated second, against raw stepping's (target: at most 1.25 times); CPU of every node together.
+Target: four robots at least 3 times real time on this 2-core machine.
 """
 
 import argparse
@@ -83,6 +84,33 @@ def raw(n: int, seconds: float):
     return seconds / wall, cpu / seconds
 
 
+def core(n: int, seconds: float):
+    """CPU [s] per simulated second of the simulator's Simulation class stepping n commanded robots, no ROS."""
+    import pybullet as p  # noqa: PLC0415
+
+    from thorvald_model.description import generate_urdf  # noqa: PLC0415
+    from thorvald_sim.robot import Pose2D  # noqa: PLC0415
+    from thorvald_sim.simulation import Simulation  # noqa: PLC0415
+    from thorvald_sim.world import load_world, resolve_world  # noqa: PLC0415
+
+    urdf = generate_urdf(STD)
+    c = p.connect(p.DIRECT)
+    try:
+        sim = Simulation(c, load_world(resolve_world("flat")))
+        for k in range(n):
+            x, y = grid(k)
+            sim.spawn(f"r{k}", urdf, Pose2D(x, y, 0.0)).command([0.0] * 4, [0.5] * 4)
+        for _ in range(240):  # under way
+            sim.step()
+        steps = round(seconds * 240)
+        cpu = time.process_time()
+        for _ in range(steps):
+            sim.step()
+        return (time.process_time() - cpu) / seconds
+    finally:
+        p.disconnect(c)
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -98,14 +126,16 @@ def cpu_seconds(pid):
         return 0.0
 
 
-def pids(pattern):
-    out = subprocess.run(["pgrep", "-f", pattern], capture_output=True, text=True).stdout.split()
-    return [int(x) for x in out]
+def node(n: int, seconds: float, port: int):
+    """(real-time factor, simulator CPU [s] per simulated second, all nodes' CPU share [cores]).
 
+    Every case runs on the one master at port (rospy initialises once per process) with a launch
+    of its own, stopped before the next case.
+    """
+    import rospy  # noqa: PLC0415
+    from geometry_msgs.msg import Twist  # noqa: PLC0415
+    from rosgraph_msgs.msg import Clock  # noqa: PLC0415
 
-def node(n: int, seconds: float):
-    """(real-time factor, simulator CPU [s] per simulated second, all nodes' CPU share [cores])."""
-    port = free_port()
     env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
     robots = "\n".join(
         f'  <include file="$(find thorvald_sim)/launch/robot.launch"><arg name="robot_name" value="r{k}"/>'
@@ -119,27 +149,20 @@ def node(n: int, seconds: float):
         f"{robots}\n</launch>\n"
     )
     launch.close()
+    clock = {"t": None}
+    sub = rospy.Subscriber("/clock", Clock, lambda m: clock.__setitem__("t", m.clock.to_sec()))
+    pubs = [rospy.Publisher(f"/r{k}/nav_vel", Twist, queue_size=1) for k in range(n)]
+    stop = threading.Event()
     proc = subprocess.Popen(
-        ["roslaunch", "-p", str(port), launch.name],
+        ["roslaunch", launch.name],
         env=env,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
         start_new_session=True,
     )
     try:
-        os.environ["ROS_MASTER_URI"] = env["ROS_MASTER_URI"]
-        import rospy  # noqa: PLC0415
-        from geometry_msgs.msg import Twist  # noqa: PLC0415
-        from rosgraph_msgs.msg import Clock  # noqa: PLC0415
-
-        if not rospy.core.is_initialized():
-            rospy.init_node("bench_sim", anonymous=True, disable_signals=True)
-        clock = {"t": None}
-        sub = rospy.Subscriber("/clock", Clock, lambda m: clock.__setitem__("t", m.clock.to_sec()))
-        pubs = [rospy.Publisher(f"/r{k}/nav_vel", Twist, queue_size=1) for k in range(n)]
         twist = Twist()
         twist.linear.x = 0.5
-        stop = threading.Event()
 
         def drive():  # faster than any mux timeout at any real-time factor reached here
             while not stop.is_set():
@@ -151,12 +174,11 @@ def node(n: int, seconds: float):
         deadline = time.time() + 120 + 15 * n
         while time.time() < deadline and (clock["t"] is None or sum(p.get_num_connections() for p in pubs) < n):
             time.sleep(0.2)
+        if clock["t"] is None:
+            raise RuntimeError(f"{n} robots: the simulator never published /clock")
         time.sleep(3.0)  # spawned and driving
-        simulator = pids("thorvald_sim/simulator") + pids("nodes/simulator")
-        every = [
-            int(x)
-            for x in subprocess.run(["pgrep", "-g", str(proc.pid)], capture_output=True, text=True).stdout.split()
-        ]
+        every = children(proc.pid)  # roslaunch starts every node in a session of its own
+        simulator = [pid for pid in every if "/simulator" in cmdline(pid).split(" __")[0]]
         t0, w0 = clock["t"], time.perf_counter()
         c0 = sum(cpu_seconds(p) for p in simulator)
         a0 = sum(cpu_seconds(p) for p in every)
@@ -165,19 +187,53 @@ def node(n: int, seconds: float):
         t1, w1 = clock["t"], time.perf_counter()
         c1 = sum(cpu_seconds(p) for p in simulator)
         a1 = sum(cpu_seconds(p) for p in every)
+        simulated = t1 - t0
+        return simulated / (w1 - w0), (c1 - c0) / simulated, (a1 - a0) / (w1 - w0)
+    finally:
         stop.set()
         sub.unregister()
         for pub in pubs:
             pub.unregister()
-        simulated = t1 - t0
-        return simulated / (w1 - w0), (c1 - c0) / simulated, (a1 - a0) / (w1 - w0)
-    finally:
-        os.killpg(proc.pid, signal.SIGINT)
+        proc.send_signal(signal.SIGINT)
         try:
             proc.wait(timeout=60)
         except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
+            for pid in children(proc.pid):
+                os.kill(pid, signal.SIGKILL)
+            proc.kill()
         os.unlink(launch.name)
+
+
+def children(pid):
+    out = subprocess.run(["pgrep", "-P", str(pid)], capture_output=True, text=True).stdout.split()
+    return [int(x) for x in out]
+
+
+def cmdline(pid):
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as f:
+            return f.read().replace(b"\0", b" ").decode(errors="replace")
+    except OSError:
+        return ""
+
+
+def master(port: int):
+    """A master of the benchmark's own, and this process as a node on it."""
+    os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
+    proc = subprocess.Popen(
+        ["rosmaster", "--core", "-p", str(port)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    import rosgraph  # noqa: PLC0415
+    import rospy  # noqa: PLC0415
+
+    deadline = time.time() + 30
+    while not rosgraph.is_master_online() and time.time() < deadline:
+        time.sleep(0.1)
+    rospy.init_node("bench_sim", anonymous=True, disable_signals=True)
+    return proc
 
 
 def main() -> int:
@@ -185,20 +241,31 @@ def main() -> int:
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated seconds measured per case")
     parser.add_argument("--robots", type=int, nargs="+", default=[1, 4, 9])
     args = parser.parse_args()
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # the master and launches are stopped on the way out
     print(
-        f"{'robots':>6} {'raw RTF':>8} {'node RTF':>9} {'raw CPU/s':>10} {'node CPU/s':>11} {'overhead':>9}"
-        f" {'all nodes':>10}"
+        f"{'robots':>6} {'raw RTF':>8} {'node RTF':>9} {'raw CPU/s':>10} {'core CPU/s':>11} {'node CPU/s':>11}"
+        f" {'overhead':>9} {'all nodes':>10}"
     )
     results = {}
-    for n in args.robots:
-        raw_rtf, raw_cpu = raw(n, args.seconds)
-        node_rtf, node_cpu, all_cpu = node(n, args.seconds)
-        results[n] = (raw_rtf, node_rtf, raw_cpu, node_cpu)
-        print(
-            f"{n:>6} {raw_rtf:>7.1f}x {node_rtf:>8.1f}x {raw_cpu:>9.3f}s {node_cpu:>10.3f}s"
-            f" {node_cpu / raw_cpu:>8.2f}x {all_cpu:>7.2f} cores",
-            flush=True,
-        )
+    port = free_port()
+    rosmaster = master(port)
+    try:
+        for n in args.robots:
+            raw_rtf, raw_cpu = raw(n, args.seconds)
+            core_cpu = core(n, args.seconds)
+            node_rtf, node_cpu, all_cpu = node(n, args.seconds, port)
+            results[n] = (raw_rtf, node_rtf, raw_cpu, node_cpu)
+            print(
+                f"{n:>6} {raw_rtf:>7.1f}x {node_rtf:>8.1f}x {raw_cpu:>9.3f}s {core_cpu:>10.3f}s {node_cpu:>10.3f}s"
+                f" {node_cpu / raw_cpu:>8.2f}x {all_cpu:>7.2f} cores",
+                flush=True,
+            )
+    finally:
+        import rospy  # noqa: PLC0415
+
+        rospy.signal_shutdown("done")
+        rosmaster.terminate()
+        rosmaster.wait(timeout=30)
     ok = True
     worst = max(results[n][3] / results[n][2] for n in results)
     verdict = worst <= TARGET_OVERHEAD

@@ -8,7 +8,7 @@ Private parameters:
 ``~gui``                  open pybullet's window (default false: headless)
 ``~physics_rate``         physics steps per simulated second [Hz] (240)
 ``~real_time_factor``     simulated seconds per wall second (1); 0 runs as fast as it can
-``~clock_rate``           /clock messages per simulated second [Hz] (200; at most one a step)
+``~clock_rate``           /clock messages per simulated second [Hz] (100; at most one a step)
 ``~odometry_rate``        odometry/gazebo and joint_states per simulated second [Hz] (50)
 ``~drive_state_rate``     drive_states per simulated second [Hz] (100)
 ``~command_timeout``      a robot whose commands stop for this long [s] stops its wheels (0.5)
@@ -37,6 +37,7 @@ import sys
 import tempfile
 import threading
 import time
+import warnings
 
 import pybullet as p
 import rospy
@@ -164,6 +165,16 @@ class RobotIO:
                     self.command_time = None
 
     def publish_odometry(self, stamp, tf):
+        """odometry/gazebo (and its tf), joint_states of the passive joints: only what somebody reads."""
+        if self.odom_pub.get_num_connections() or self.publish_tf:
+            self._publish_odometry(stamp, tf)
+        if self.passive and self.joint_pub.get_num_connections():
+            states = self.robot.joint_states(self.passive)
+            self.joint_pub.publish(
+                conversions.joint_state_msg(stamp, self.passive_names, [s[0] for s in states], [s[1] for s in states])
+            )
+
+    def _publish_odometry(self, stamp, tf):
         d = self.robot.description
         position, orientation = self.robot.odom_pose()
         linear, angular = self.robot.body_twist()
@@ -179,14 +190,10 @@ class RobotIO:
         self.odom_pub.publish(msg)
         if self.publish_tf:
             tf.sendTransform(conversions.odometry_transform(msg))
-        if self.passive:
-            states = self.robot.joint_states(self.passive)
-            self.joint_pub.publish(
-                conversions.joint_state_msg(stamp, self.passive_names, [s[0] for s in states], [s[1] for s in states])
-            )
 
     def publish_drives(self, stamp):
-        self.drive_pub.publish(conversions.state_msg(stamp, self.robot.drive_states()))
+        if self.drive_pub.get_num_connections():  # base_driver with measured drives
+            self.drive_pub.publish(conversions.state_msg(stamp, self.robot.drive_states()))
 
     def close(self):
         self.sub.unregister()
@@ -201,7 +208,7 @@ class SimulatorNode:
         self.gui = bool(rospy.get_param("~gui", False))
         physics_rate = positive("physics_rate", 240.0)
         self.real_time_factor = positive("real_time_factor", 1.0, allow_zero=True)
-        clock_rate = positive("clock_rate", 200.0)
+        clock_rate = positive("clock_rate", 100.0)
         odometry_rate = positive("odometry_rate", 50.0)
         drive_state_rate = positive("drive_state_rate", 100.0)
         self.command_timeout = positive("command_timeout", 0.5)
@@ -216,7 +223,9 @@ class SimulatorNode:
         self.clock = Every(clock_rate)
         self.odometry = Every(odometry_rate)
         self.drives = Every(drive_state_rate)
-        self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10)
+        with warnings.catch_warnings():  # rospy warns of queue_size=None, which is the point here:
+            warnings.simplefilter("ignore")  # /clock goes to every node; written in the loop it costs half
+            self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=None)  # what a writer thread each does
         self.tf = tf2_ros.TransformBroadcaster()
         rospy.Service("~pause", Empty, self.srv_pause)
         rospy.Service("~unpause", Empty, self.srv_unpause)
