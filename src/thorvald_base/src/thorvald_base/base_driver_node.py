@@ -25,7 +25,10 @@ Private parameters besides the configuration:
 ``~projection``                    unrealisable twists on a fixed axle: ``axle`` (default) or ``lsq``
 ``~measured_timeout``              with ``base_handle: simulated_joints``: drive states older than
                                    this stop the wheels [s] (default 0.5)
-``~can_interface_type/name``       the CAN line of a real base
+``~can_interface_type/name``       the CAN line of a real base: a python-can interface
+                                   (``socketcan``, ``slcan``, ``virtual``, ``pcan``, ...) and channel
+``~can_bitrate``                   for interfaces that set it (default 1000000)
+``~allow_relay_to_base_devices``   relay frames addressed to the base's own devices (default false)
 =================================  ===========================================================
 
 A bad configuration or parameter stops the node at start with a fatal log naming it, exit status 1.
@@ -36,14 +39,22 @@ import threading
 
 import rospy
 import tf2_ros
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import BatteryState, JointState
 from std_srvs.srv import SetBool, SetBoolResponse, Trigger, TriggerResponse
 
 from thorvald_model import ConfigError, load_robot_config, parse_robot_config
-from thorvald_msgs.msg import BaseState, BatteryArray, ControllerArray
-from thorvald_msgs.srv import DriveParams, DriveParamsResponse
+from thorvald_msgs.msg import BaseState, BatteryArray, CANFrame, ControllerArray, IOArray
+from thorvald_msgs.srv import (
+    CanID,
+    CanIDResponse,
+    DriveParams,
+    DriveParamsResponse,
+    MotorControllerSetup,
+    MotorControllerSetupResponse,
+)
 
 from . import conversions
 from .bases import create_base_handle, handle_name
@@ -67,6 +78,8 @@ NODE_PARAMS = (
     "measured_timeout",
     "can_interface_type",
     "can_interface_name",
+    "can_bitrate",
+    "allow_relay_to_base_devices",
     "joint_states_remap_to",
 )
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
@@ -132,6 +145,16 @@ class BaseDriverNode:
         self.command_pub = rospy.Publisher("joint_commands", BaseState, queue_size=10)
         self.battery_pub = rospy.Publisher("battery_data", BatteryArray, queue_size=1)
         self.controller_pub = rospy.Publisher("motor_controller_data", ControllerArray, queue_size=1)
+        self.io_pub = rospy.Publisher("io_data", IOArray, queue_size=1)
+        self.battery_state_pubs = {
+            b.id: rospy.Publisher("battery_state/" + b.name, BatteryState, queue_size=1)
+            for b in self.config.batteries
+            if b.type == 1 and b.with_battery
+        }
+        self.diagnostics_pub = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=1)
+        self.frames_base_pub = rospy.Publisher("can_frames_base_r", CANFrame, queue_size=200)
+        self.frames_device_pub = rospy.Publisher("can_frames_device_r", CANFrame, queue_size=200)
+        rospy.Subscriber("can_frames_device_t", CANFrame, self.on_device_frame, queue_size=100)
         self.tf = tf2_ros.TransformBroadcaster() if self.enable_tf else None
         self.gazebo_odom = None
         if params.get("passthrough_gazebo_odometry", False):
@@ -141,6 +164,12 @@ class BaseDriverNode:
         rospy.Service("~reset_base_odom", Trigger, self.srv_reset_odom)
         rospy.Service("~safety_stop", SetBool, self.srv_safety_stop)
         rospy.Service("~set_drive_params", DriveParams, self.srv_set_drive_params)
+        rospy.Service("~mute_extra_can_device_commands", SetBool, self.srv_mute)
+        rospy.Service("~setup_motor_controller", MotorControllerSetup, self.srv_setup_motor_controller)
+        rospy.Service("~set_home_count_current_pos_zero", CanID, self.srv_set_home_count)
+        for board in self.config.io:
+            for relay in range(2):
+                rospy.Service(f"~io{board.id}_rl{relay}", SetBool, self._relay_service(board.id, relay))
         self._last_status_publish = None
         rospy.loginfo(
             "base_driver: %d drives, calculator %s, base %s, %.0f Hz, odom tf %s",
@@ -164,6 +193,43 @@ class BaseDriverNode:
         msg.header.frame_id = self.odom_frame
         self.gazebo_odom = msg
         self.odom_pub.publish(msg)
+
+    def on_device_frame(self, msg):
+        try:
+            frame = conversions.frame_of(msg)
+        except ValueError as e:
+            rospy.logwarn_throttle(WARN_PERIOD, "base_driver: can_frames_device_t: a frame refused: %s", e)
+            return
+        with self.lock:
+            problem = self.core.handle.relay(frame)
+        if problem:
+            rospy.logwarn_throttle(WARN_PERIOD, "base_driver: can_frames_device_t: %s", problem)
+
+    def srv_mute(self, req):
+        with self.lock:
+            message = self.core.handle.mute(bool(req.data))
+        return SetBoolResponse(True, message)
+
+    def srv_setup_motor_controller(self, req):
+        with self.lock:
+            status, message = self.core.handle.setup_motor_controller(req.can_id, req.setup_id, req.setup_value)
+        return MotorControllerSetupResponse(status, message)
+
+    def srv_set_home_count(self, req):
+        with self.lock:
+            status, message = self.core.handle.set_home_count_current_pos_zero(req.can_id)
+        return CanIDResponse(status, message)
+
+    def _relay_service(self, io_id, relay):
+        def call(req):
+            try:
+                with self.lock:
+                    message = self.core.handle.set_relay(io_id, relay, bool(req.data))
+            except ThorvaldBaseError as e:
+                return SetBoolResponse(False, str(e))
+            return SetBoolResponse(True, message)
+
+        return call
 
     def srv_home_steering(self, _req):
         with self.lock:
@@ -225,15 +291,66 @@ class BaseDriverNode:
         self.joint_pub.publish(conversions.drive_joint_state_msg(stamp, self.joint_names, drives, result.states))
         if self.gazebo_odom is None:
             self.publish_odometry(result.odometry, stamp)
+        handle = self.core.handle
+        with self.lock:
+            claimed, unclaimed = handle.take_received()
+        for frame in claimed:
+            self.frames_base_pub.publish(conversions.frame_msg(stamp, frame))
+        for frame in unclaimed:
+            self.frames_device_pub.publish(conversions.frame_msg(stamp, frame))
         if self._last_status_publish is None or (stamp - self._last_status_publish).to_sec() >= STATUS_PERIOD:
             self._last_status_publish = stamp
-            handle = self.core.handle
-            batteries = handle.batteries(result.time)
+            with self.lock:
+                batteries = handle.batteries(result.time)
+                controllers = handle.controllers(result.time)
+                boards = handle.io_boards(result.time)
+                link = handle.diagnostics(result.time)
             if batteries:
                 self.battery_pub.publish(conversions.battery_array_msg(stamp, batteries))
-            controllers = handle.controllers(result.time)
+                for b in batteries:
+                    pub = self.battery_state_pubs.get(b.id)
+                    if pub is not None:
+                        pub.publish(conversions.battery_state_msg(stamp, self.base_frame, b))
             if controllers:
                 self.controller_pub.publish(conversions.controller_array_msg(stamp, controllers))
+            if boards:
+                self.io_pub.publish(conversions.io_array_msg(stamp, boards))
+            self.publish_diagnostics(stamp, controllers, batteries, link)
+
+    def publish_diagnostics(self, stamp, controllers, batteries, link):
+        """/diagnostics: one status per motor controller and battery, one for the bus."""
+        lost = DiagnosticStatus.ERROR
+        statuses = []
+        ns = rospy.get_namespace().strip("/")
+        prefix = f"base_driver ({ns}): " if ns else "base_driver: "
+        for c in controllers:
+            level = lost if c.mode == 4 else DiagnosticStatus.OK
+            flags = [name for name, on in c.status_flags if on]
+            if level == DiagnosticStatus.OK and flags:
+                level = DiagnosticStatus.WARN
+            message = "lost connection" if c.mode == 4 else (", ".join(flags) if flags else "ok")
+            values = {"mode": c.mode, "battery volts": f"{c.battery_volts:.1f}", "version": c.version}
+            statuses.append(
+                conversions.diagnostic_status(
+                    f"{prefix}motor controller {c.name}", f"node {c.can_id}", level, message, values
+                )
+            )
+        for b in batteries:
+            level = lost if b.state == 2 else (DiagnosticStatus.WARN if b.alarms else DiagnosticStatus.OK)
+            message = "lost connection" if b.state == 2 else (", ".join(b.alarms) if b.alarms else "ok")
+            values = {"voltage": f"{b.voltage:.2f}", "state of charge": f"{b.state_of_charge:.0f} %"}
+            statuses.append(
+                conversions.diagnostic_status(f"{prefix}battery {b.id}", f"battery {b.id}", level, message, values)
+            )
+        if link:
+            level = DiagnosticStatus.ERROR if "closed" in link.get("bus", "") else DiagnosticStatus.OK
+            if level == DiagnosticStatus.OK and link.get("wheels stopped: lost"):
+                level = DiagnosticStatus.ERROR
+            statuses.append(conversions.diagnostic_status(f"{prefix}CAN bus", "can", level, link.get("bus", ""), link))
+        if statuses:
+            msg = DiagnosticArray(status=statuses)
+            msg.header.stamp = stamp
+            self.diagnostics_pub.publish(msg)
 
     def publish_odometry(self, odometry, stamp):
         if not odometry.valid:

@@ -6,23 +6,28 @@ without a master. Stamps are ``rospy.Time``/``genpy.Time`` values the caller pas
 """
 
 import math
-from typing import List, Sequence
+from typing import Dict, List, Sequence
 
+from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Quaternion, TransformStamped
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import BatteryState, JointState
+from std_msgs.msg import Header
 
 from thorvald_msgs.msg import (
     BaseState,
     BatteryArray,
     BatteryData,
+    CANFrame,
     Controller,
     ControllerArray,
+    IOArray,
+    IOData,
     MotorVars,
     StatusFlag,
 )
 
-from .bases import BatteryInfo, ControllerInfo, MeasuredDrive
+from .bases import BatteryInfo, ControllerInfo, Frame, IoInfo, MeasuredDrive
 from .kinematics import DriveCommand, OdometryResult
 
 
@@ -209,3 +214,70 @@ def controller_array_msg(stamp, controllers: Sequence[ControllerInfo]) -> Contro
             )
         )
     return msg
+
+
+def battery_state_msg(stamp, frame_id: str, b: BatteryInfo) -> BatteryState:
+    """sensor_msgs/BatteryState of one battery (voltage, current, charge as a fraction, health)."""
+    msg = BatteryState()
+    msg.header.stamp = stamp
+    msg.header.frame_id = frame_id
+    msg.voltage = b.voltage
+    msg.current = b.current
+    msg.charge = math.nan
+    msg.capacity = b.capacity if b.capacity > 0 else math.nan
+    msg.design_capacity = math.nan
+    msg.percentage = b.state_of_charge / 100.0
+    msg.temperature = max(b.temperatures) if b.temperatures else math.nan
+    msg.power_supply_technology = BatteryState.POWER_SUPPLY_TECHNOLOGY_LION
+    msg.present = b.state != 2
+    if b.state == 2:
+        msg.power_supply_status = BatteryState.POWER_SUPPLY_STATUS_UNKNOWN
+        msg.power_supply_health = BatteryState.POWER_SUPPLY_HEALTH_UNKNOWN
+    else:
+        msg.power_supply_status = (
+            BatteryState.POWER_SUPPLY_STATUS_CHARGING if b.current > 0 else BatteryState.POWER_SUPPLY_STATUS_DISCHARGING
+        )
+        msg.power_supply_health = (
+            BatteryState.POWER_SUPPLY_HEALTH_GOOD if not b.alarms else BatteryState.POWER_SUPPLY_HEALTH_UNSPEC_FAILURE
+        )
+    msg.location = f"battery {b.id}"
+    return msg
+
+
+def io_array_msg(stamp, boards: Sequence[IoInfo]) -> IOArray:
+    msg = IOArray()
+    msg.header.stamp = stamp
+    msg.ios = [IOData(b.id, b.type, list(b.relays), list(b.analog), b.online) for b in boards]
+    return msg
+
+
+def frame_msg(stamp, frame: Frame) -> CANFrame:
+    data = bytes(frame.data[:8])
+    return CANFrame(
+        header=Header(stamp=stamp),
+        id=frame.id,
+        length=len(data),
+        data=data + bytes(8 - len(data)),
+        is_extended=frame.is_extended,
+        is_remote=frame.is_remote,
+    )
+
+
+def frame_of(msg: CANFrame) -> Frame:
+    """A relayed CANFrame as the handle takes it; ValueError when it cannot be a CAN frame."""
+    if not 0 <= msg.length <= 8:
+        raise ValueError(f"length {msg.length}: a CAN frame carries 0..8 bytes")
+    limit = 0x1FFFFFFF if msg.is_extended else 0x7FF
+    if not 0 <= msg.id <= limit:
+        raise ValueError(f"id 0x{msg.id:X}: above 0x{limit:X} for a {'29' if msg.is_extended else '11'}-bit frame")
+    return Frame(msg.id, bytes(bytearray(msg.data))[: msg.length], msg.is_extended, msg.is_remote)
+
+
+def diagnostic_status(name: str, hardware_id: str, level: int, message: str, values: Dict[str, str]):
+    return DiagnosticStatus(
+        level=level,
+        name=name,
+        message=message,
+        hardware_id=hardware_id,
+        values=[KeyValue(k, str(v)) for k, v in values.items()],
+    )

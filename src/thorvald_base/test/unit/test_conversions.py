@@ -5,11 +5,13 @@ import math
 import pytest
 from base_test_helpers import EXAMPLE_ROBOTS
 from genpy import Time
+from sensor_msgs.msg import BatteryState
 
 from thorvald_base import conversions
-from thorvald_base.bases import BatteryInfo, ControllerInfo, MeasuredDrive
+from thorvald_base.bases import BatteryInfo, ControllerInfo, Frame, IoInfo, MeasuredDrive
 from thorvald_base.kinematics import DriveCommand, OdometryResult, Pose, Twist
 from thorvald_model import load_robot_config
+from thorvald_msgs.msg import CANFrame
 
 STAMP = Time(12, 500)
 
@@ -112,3 +114,30 @@ def test_batteries_and_controllers():
     assert (c.name, c.can_id, c.controller_mode) == ("drive0", 1, 3)
     assert (c.status_flags[0].status_name, c.status_flags[0].status_value) == ("stall", True)
     assert (c.motor_vars[0].type, c.motor_vars[0].motor_amps) == ("propulsion", 2.0)
+
+
+def test_relayed_frames_both_ways():
+    msg = conversions.frame_msg(Time(3, 0), Frame(0x185, bytes([1, 2, 3])))
+    assert (msg.id, msg.length, bytes(bytearray(msg.data))) == (0x185, 3, bytes([1, 2, 3, 0, 0, 0, 0, 0]))
+    assert msg.header.stamp == Time(3, 0)
+    # what code written for the original publishes: id, length, data only
+    frame = conversions.frame_of(CANFrame(id=20, length=2, data=[9, 8, 7, 0, 0, 0, 0, 0]))
+    assert (frame.id, frame.data, frame.is_extended) == (20, bytes([9, 8]), False)
+    assert conversions.frame_of(CANFrame(id=0x18FF1234, length=8, data=[0] * 8, is_extended=True)).is_extended
+    with pytest.raises(ValueError, match=r"length 9: a CAN frame carries 0..8 bytes"):
+        conversions.frame_of(CANFrame(id=1, length=9, data=[0] * 8))
+    with pytest.raises(ValueError, match=r"id 0x800: above 0x7FF for a 11-bit frame"):
+        conversions.frame_of(CANFrame(id=0x800, length=0, data=[0] * 8))
+
+
+def test_battery_state_and_io_messages():
+    b = BatteryInfo(1, 1, 87.0, 96.0, 50.1, -12.5, capacity=100.0, temperatures=(21.0, 25.0), alarms=("bms_fail",))
+    msg = conversions.battery_state_msg(Time(1, 0), "robot/base_link", b)
+    assert (msg.voltage, msg.current, msg.capacity, msg.temperature) == pytest.approx((50.1, -12.5, 100.0, 25.0))
+    assert msg.percentage == pytest.approx(0.87) and msg.present
+    assert msg.power_supply_status == BatteryState.POWER_SUPPLY_STATUS_DISCHARGING
+    assert msg.power_supply_health == BatteryState.POWER_SUPPLY_HEALTH_UNSPEC_FAILURE
+    gone = conversions.battery_state_msg(Time(1, 0), "", BatteryInfo(1, 2, 0.0, 0.0, 0.0, 0.0))
+    assert not gone.present and math.isnan(gone.capacity)
+    io = conversions.io_array_msg(Time(2, 0), [IoInfo(3, 0, (True, False), (12.0, 5.0, 0.0), True)])
+    assert io.ios[0].id == 3 and list(io.ios[0].relay_states) == [True, False] and io.ios[0].online

@@ -96,10 +96,12 @@ def test_the_factory_picks_the_handle_from_the_parameters():
     assert handle_name({"simple_sim": False, "base_handle": "simple_sim"}) == "simple_sim"
     assert isinstance(create_base_handle(config, {"simple_sim": True}), SimulatedBase)
     with pytest.raises(
-        ParameterError, match=r"~base_handle: 'warp': no such base handle; available: simple_sim, simulated_joints$"
+        ParameterError,
+        match=r"~base_handle: 'warp': no such base handle; available: can, simple_sim, simulated_joints$",
     ):
         create_base_handle(config, {"base_handle": "warp"})
-    with pytest.raises(ParameterError, match=r"'can' \(simple_sim False\).*available: simple_sim.*simple_sim:=true"):
+    # simple_sim false is the CAN base, which needs a python-can interface
+    with pytest.raises(ParameterError, match=r"~can_interface_type: empty: name a python-can interface"):
         create_base_handle(config, {"simple_sim": False})
 
 

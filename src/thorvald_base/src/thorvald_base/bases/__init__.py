@@ -13,6 +13,9 @@ name                  handle
 ``simulated_joints``  :class:`~thorvald_base.bases.simulated_joints.SimulatedJointsBase`: drives
                       measured from a physics simulator's joints (``drive_commands`` out,
                       ``drive_states`` in; ``~measured_timeout``, 0.5 s)
+``can``               :class:`~thorvald_base.bases.can_base.CanBase`: motor controllers,
+                      batteries and IO boards on a python-can bus (``~can_interface_type``,
+                      ``~can_interface_name``)
 ====================  =======================================================================
 """
 
@@ -20,11 +23,12 @@ import importlib
 from typing import Dict, List
 
 from ..errors import ParameterError
-from .handle import BaseHandle, BatteryInfo, ControllerInfo, MeasuredDrive
+from .handle import BaseHandle, BatteryInfo, ControllerInfo, Frame, IoInfo, MeasuredDrive
 
 BASE_HANDLES: Dict[str, str] = {
     "simple_sim": "thorvald_base.bases.simulated:SimulatedBase",
     "simulated_joints": "thorvald_base.bases.simulated_joints:SimulatedJointsBase",
+    "can": "thorvald_base.bases.can_base:CanBase",
 }
 
 
@@ -48,7 +52,6 @@ def create_base_handle(config, params: dict) -> BaseHandle:
         origin = "" if params.get("base_handle") else f" (simple_sim {bool(params.get('simple_sim', False))})"
         raise ParameterError(
             f"~base_handle: {name!r}{origin}: no such base handle; available: {', '.join(known_handles())}"
-            + ("; set simple_sim:=true to simulate the drives" if name == "can" else "")
         )
     module_name, _, class_name = target.partition(":")
     cls = getattr(importlib.import_module(module_name), class_name)
@@ -60,6 +63,8 @@ __all__ = [
     "BaseHandle",
     "BatteryInfo",
     "ControllerInfo",
+    "Frame",
+    "IoInfo",
     "MeasuredDrive",
     "create_base_handle",
     "handle_name",

@@ -9,7 +9,7 @@ Times are seconds on whichever clock the node uses (ROS time, simulated time in 
 """
 
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 from thorvald_model.config import RobotConfig
 
@@ -68,6 +68,28 @@ class ControllerInfo:
     temps: Tuple[float, ...] = ()  # [degC]
     status_flags: Tuple[Tuple[str, bool], ...] = ()
     motor_vars: Tuple[Tuple[str, float, float, float, float], ...] = ()  # (type, speed, position, amps, power)
+
+
+@dataclass(frozen=True)
+class IoInfo:
+    """One IO board as io_data reports it (thorvald_msgs/IOData)."""
+
+    id: int
+    type: int
+    relays: Tuple[bool, ...]
+    analog: Tuple[float, ...]  # [V]
+    online: bool
+
+
+@dataclass
+class Frame:
+    """A CAN frame, independent of python-can and of ROS messages (the relay for implements)."""
+
+    id: int
+    data: bytes
+    is_extended: bool = False
+    is_remote: bool = False
+    time: float = 0.0
 
 
 class BaseHandle:
@@ -139,6 +161,40 @@ class BaseHandle:
 
     def controllers(self, time: float) -> List[ControllerInfo]:
         return []
+
+    def io_boards(self, time: float) -> List[IoInfo]:
+        return []
+
+    def diagnostics(self, time: float) -> Dict[str, str]:
+        """Key/values about the hardware link for /diagnostics (bus errors, counters); none by default."""
+        return {}
+
+    # ---- a CAN bus's services; a base without one answers that it has none ----------------------
+    NO_BUS = "this base has no CAN bus (base handle {name})"
+
+    def _no_bus(self) -> str:
+        return self.NO_BUS.format(name=type(self).__name__)
+
+    def relay(self, frame: Frame) -> Optional[str]:
+        """Queues a frame from can_frames_device_t for the bus; the reason if it is refused or dropped."""
+        return self._no_bus()
+
+    def take_received(self) -> Tuple[List[Frame], List[Frame]]:
+        """(frames base devices claimed, frames none claimed) received since the last call."""
+        return [], []
+
+    def mute(self, muted: bool) -> str:
+        """Stops (or resumes) relaying frames from can_frames_device_t; the queue is cleared."""
+        return self._no_bus()
+
+    def setup_motor_controller(self, node: int, setup_id: int, value: int) -> Tuple[int, str]:
+        return -1, self._no_bus()
+
+    def set_home_count_current_pos_zero(self, node: int) -> Tuple[int, str]:
+        return -1, self._no_bus()
+
+    def set_relay(self, io_id: int, relay: int, on: bool) -> str:
+        raise ThorvaldBaseError(self._no_bus())
 
     @property
     def closed(self) -> bool:
