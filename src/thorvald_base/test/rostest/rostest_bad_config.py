@@ -137,6 +137,20 @@ class BadConfigTest(unittest.TestCase):
     def test_bad_node_parameter(self):
         self.refuses("bad_rate", GOOD, "~rate", rate=-5.0)
 
+    def test_can_buses_that_cannot_be_used(self):
+        cases = (
+            ("enc_pcb", "enc_pcb_v1rev6", "/dev/ttyUSB0", "never published; use a python-can interface instead"),
+            ("unknown_interface", "warpcan", "x", "'warpcan': not a python-can interface"),
+            ("no_interface", "", "", "~can_interface_type: empty"),
+            ("missing_adapter", "slcan", "/nonexistent/ttyACM0", "CAN bus slcan '/nonexistent/ttyACM0' will not open"),
+        )
+        for name, interface, channel, reason in cases:
+            with self.subTest(interface=interface):
+                err = self.refuses(
+                    name, GOOD, reason, simple_sim=False, can_interface_type=interface, can_interface_name=channel
+                )
+                self.assertEqual(len([line for line in err.splitlines() if "FATAL" in line]), 1, err)
+
     def test_good_file_starts(self):
         # the same ways of starting the node, with the good file: it runs and publishes odometry
         for name, start in (("good_driver", start_driver), ("good_driver_on_file", start_driver_on_file)):

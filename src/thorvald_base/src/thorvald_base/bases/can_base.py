@@ -13,6 +13,7 @@ Parameters (base_driver's private ones): ``can_interface_type`` (any python-can 
 
 import collections
 import math
+import time as wall
 from dataclasses import dataclass, field
 from typing import Deque, Dict, List, Optional, Sequence, Tuple
 
@@ -38,6 +39,7 @@ UNPUBLISHED_INTERFACES = ("enc_pcb_v1rev6", "enc_pcb_v2rev1")
 RELAY_QUEUE_LIMIT = 100  # frames relayed per cycle; the original dropped its queue past 100
 READ_LIMIT = 2000  # frames read per cycle at most (a flooded bus cannot stall the loop)
 DEFAULT_BITRATE = 1000000
+REOPEN_PERIOD = 1.0  # [s] of wall time between attempts to reopen a failed bus
 
 
 @dataclass
@@ -89,6 +91,7 @@ class CanBase(BaseHandle):
         super().__init__(config)
         self.bus = bus
         self._reopen = reopen  # () -> a new bus, after bus errors
+        self._next_reopen = 0.0  # [s] monotonic
         self.counters = BusCounters()
         self.controllers_: List[MotorController] = []
         by_node: Dict[int, List[int]] = {}
@@ -308,6 +311,10 @@ class CanBase(BaseHandle):
     def _try_reopen(self) -> bool:
         if self._reopen is None:
             return self.bus is not None
+        now = wall.monotonic()
+        if now < self._next_reopen:
+            return False
+        self._next_reopen = now + REOPEN_PERIOD
         try:
             self.bus = self._reopen()
         except ThorvaldBaseError as e:

@@ -1,0 +1,88 @@
+"""The SLCAN hub: python-can's own slcan interface on each pseudo-terminal, every participant
+seeing the others' frames, SLCAN commands acknowledged, a port unplugged and plugged back."""
+
+import contextlib
+import os
+import threading
+
+import can
+import pytest
+
+from thorvald_sim.can_hub import Hub, decode_slcan, encode_slcan
+
+
+def test_slcan_lines_both_ways():
+    msg = can.Message(arbitration_id=0x185, data=[1, 0xAB], is_extended_id=False)
+    assert encode_slcan(msg) == b"t1852" + b"01AB\r"
+    ext = can.Message(arbitration_id=0x18FF1234, data=[], is_extended_id=True)
+    assert encode_slcan(ext) == b"T18FF12340\r"
+    back = decode_slcan(b"t1852" + b"01AB")
+    assert (back.arbitration_id, bytes(back.data), back.is_extended_id) == (0x185, b"\x01\xab", False)
+    assert decode_slcan(b"r1230").is_remote_frame
+    assert decode_slcan(b"O") is None
+    with pytest.raises(ValueError):
+        decode_slcan(b"t1853" + b"01")  # shorter than its dlc
+
+
+@pytest.fixture
+def hub(tmp_path):
+    h = Hub(f"hub-test-{os.getpid()}", ports=3, link_dir=str(tmp_path))
+    stop = threading.Event()
+
+    def pump():
+        while not stop.is_set():
+            h.pump(0.002)
+
+    thread = threading.Thread(target=pump, daemon=True)
+    thread.start()
+    yield h, tmp_path
+    stop.set()
+    thread.join(2)
+    h.close()
+
+
+def open_port(path):
+    return can.Bus(interface="slcan", channel=str(path), sleep_after_open=0, bitrate=1000000)
+
+
+def test_participants_see_each_other(hub):
+    h, links = hub
+    inside = h.participant()
+    a, b = open_port(links / "port0"), open_port(links / "port1")
+    try:
+        a.send(can.Message(arbitration_id=0x123, data=[1, 2, 3], is_extended_id=False))
+        for bus in (b, inside):  # the other port and the in-process participant
+            got = bus.recv(2.0)
+            assert got is not None and (got.arbitration_id, bytes(got.data)) == (0x123, b"\x01\x02\x03")
+        inside.send(can.Message(arbitration_id=0x18FF0001, data=[9], is_extended_id=True))
+        for bus in (a, b):
+            got = bus.recv(2.0)
+            while got is not None and got.arbitration_id != 0x18FF0001:
+                got = bus.recv(2.0)
+            assert got is not None and got.is_extended_id
+        assert a.recv(0.2) is None  # nobody sees its own frames
+    finally:
+        a.shutdown()
+        b.shutdown()
+        inside.shutdown()
+
+
+def test_a_dropped_port_comes_back_at_its_link(hub):
+    h, links = hub
+    bus = open_port(links / "port0")
+    h.drop(0)
+    with pytest.raises(can.CanError):
+        for _ in range(50):  # the adapter is gone: reading fails
+            bus.recv(0.05)
+    with contextlib.suppress(can.CanError):
+        bus.shutdown()  # python-can writes "C" to the adapter first
+    h.restore(0)
+    again = open_port(links / "port0")
+    other = open_port(links / "port1")
+    try:
+        other.send(can.Message(arbitration_id=0x42, data=[4], is_extended_id=False))
+        got = again.recv(2.0)
+        assert got is not None and got.arbitration_id == 0x42
+    finally:
+        again.shutdown()
+        other.shutdown()
