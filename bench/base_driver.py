@@ -118,11 +118,13 @@ class Bench:
     def robot_file(self, robot):
         return os.path.join(self.config_dir, robot, robot + ".yaml")
 
-    def start_driver(self, ns, robot, rate):
+    def start_driver(self, ns, robot, rate, **extra):
+        """base_driver in /ns with the robot's file, simple_sim unless extra parameters say otherwise."""
         path = self.robot_file(robot)
         with open(path) as f:
             params = yaml.safe_load(f)
         params.update({"robot_model": path, "simple_sim": True, "rate": float(rate), "enable_odom_tf": True})
+        params.update(extra)
         rospy.set_param(f"/{ns}/base_driver", params)
         p = self.procs.start(
             [
@@ -249,9 +251,9 @@ class Bench:
         t.start()
         return t
 
-    def cpu_and_rate(self, ns, robot, rate, window):
+    def cpu_and_rate(self, ns, robot, rate, window, **extra):
         """(CPU share of one core [%], achieved odometry rate [Hz]) of a driver at ~rate."""
-        p = self.start_driver(ns, robot, rate)
+        p = self.start_driver(ns, robot, rate, **extra)
         stop = threading.Event()
         subs = []
         try:

@@ -294,10 +294,10 @@ class BaseDriverNode:
         handle = self.core.handle
         with self.lock:
             claimed, unclaimed = handle.take_received()
-        for frame in claimed:
-            self.frames_base_pub.publish(conversions.frame_msg(stamp, frame))
-        for frame in unclaimed:
-            self.frames_device_pub.publish(conversions.frame_msg(stamp, frame))
+        for pub, frames in ((self.frames_base_pub, claimed), (self.frames_device_pub, unclaimed)):
+            if frames and pub.get_num_connections():  # hundreds a second: built only when somebody reads
+                for frame in frames:
+                    pub.publish(conversions.frame_msg(stamp, frame))
         if self._last_status_publish is None or (stamp - self._last_status_publish).to_sec() >= STATUS_PERIOD:
             self._last_status_publish = stamp
             with self.lock:

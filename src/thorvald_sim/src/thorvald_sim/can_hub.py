@@ -13,6 +13,7 @@ No ROS here; ``can_emulator_node`` runs a hub with the emulator.
 import errno
 import os
 import select
+import termios
 import threading
 import tty
 from typing import List, Optional
@@ -21,6 +22,7 @@ import can
 
 ACK = b"\r"
 NACK = b"\a"
+MAX_PENDING = 65536  # [bytes] waiting for a participant that does not read; whole frames beyond are dropped
 
 
 def encode_slcan(msg: can.Message) -> bytes:
@@ -59,8 +61,10 @@ class SlcanPort:
         self.master = self.slave = -1
         self.bus: Optional[can.BusABC] = None
         self.buffer = b""
+        self.pending = b""  # frames the terminal had no room for yet
+        self.channel_open = False  # SLCAN "O" .. "C": frames flow only while the channel is open
         self.malformed = 0
-        self.dropped = 0  # frames that found the terminal full
+        self.dropped = 0  # frames dropped for a participant that does not read
         self.open()
 
     @property
@@ -79,7 +83,8 @@ class SlcanPort:
             os.symlink(self.path, tmp)
             os.replace(tmp, self.link)
         self.bus = can.Bus(interface="virtual", channel=self.channel, receive_own_messages=False)
-        self.buffer = b""
+        self.buffer = self.pending = b""
+        self.channel_open = False
 
     def close(self) -> None:
         """As an adapter unplugged: the terminal goes away (the link stays, dangling, until reopened)."""
@@ -116,6 +121,14 @@ class SlcanPort:
                 self.bus.send(msg)
                 continue
             command = line[:1]
+            if command == b"O":  # the channel opens: what an earlier participant left unread is stale
+                termios.tcflush(self.slave, termios.TCIFLUSH)
+                self.pending = b""
+                while self.bus.recv(timeout=0.0) is not None:
+                    pass
+                self.channel_open = True
+            elif command == b"C":
+                self.channel_open = False
             if command == b"V":
                 replies += b"V1013" + ACK
             elif command == b"N":
@@ -125,26 +138,33 @@ class SlcanPort:
             else:
                 replies += NACK
         if replies:
-            self._write(replies)
+            self.pending += replies
 
     def to_terminal(self) -> None:
-        """Writes the other participants' frames to the participant."""
-        out = b""
+        """Writes the other participants' frames to the participant while its channel is open."""
+        frames = []
         while True:
             msg = self.bus.recv(timeout=0.0)
             if msg is None:
                 break
-            out += encode_slcan(msg)
-        if out:
-            self._write(out)
+            if self.channel_open:
+                frames.append(encode_slcan(msg))
+        for frame in frames:  # whole frames only: a participant never reads half a line
+            if len(self.pending) + len(frame) > MAX_PENDING:
+                self.dropped += 1
+            else:
+                self.pending += frame
+        if self.pending:
+            self.pending = self.pending[self._write(self.pending) :]
 
-    def _write(self, data: bytes) -> None:
+    def _write(self, data: bytes) -> int:
+        """Bytes written (the terminal may take part of them)."""
         try:
-            os.write(self.master, data)
+            return os.write(self.master, data)
         except OSError as e:
-            if e.errno != errno.EAGAIN:
-                raise
-            self.dropped += 1  # nobody reads this terminal: as a wire, the bus does not wait
+            if e.errno in (errno.EAGAIN, errno.EIO):
+                return 0
+            raise
 
 
 class Hub:

@@ -8,6 +8,7 @@ import threading
 import can
 import pytest
 
+from thorvald_base.can.slcan import BufferedSlcanBus
 from thorvald_sim.can_hub import Hub, decode_slcan, encode_slcan
 
 
@@ -41,8 +42,14 @@ def hub(tmp_path):
     h.close()
 
 
-def open_port(path):
-    return can.Bus(interface="slcan", channel=str(path), sleep_after_open=0, bitrate=1000000)
+def open_port(path, bus_class=None):
+    """A participant on the port, once the hub has opened its channel (the version reply comes after "O")."""
+    if bus_class is None:
+        bus = can.Bus(interface="slcan", channel=str(path), sleep_after_open=0, bitrate=1000000)
+    else:
+        bus = bus_class(channel=str(path), sleep_after_open=0)
+    assert bus.get_version(2.0) == (10, 13)
+    return bus
 
 
 def test_participants_see_each_other(hub):
@@ -85,4 +92,28 @@ def test_a_dropped_port_comes_back_at_its_link(hub):
         assert got is not None and got.arbitration_id == 0x42
     finally:
         again.shutdown()
+        other.shutdown()
+
+
+def test_base_drivers_slcan_reader_and_batch_writer(hub):
+    """thorvald_base's BufferedSlcanBus: a batch goes out in order, a backlog is read whole frames at a time."""
+    _, links = hub
+    base = open_port(links / "port0", BufferedSlcanBus)
+    other = open_port(links / "port1")
+    try:
+        base.send_batch(
+            [can.Message(arbitration_id=0x200 + k, data=[k] * 8, is_extended_id=False) for k in range(1, 10)]
+        )
+        got = [other.recv(2.0) for _ in range(9)]
+        assert [(m.arbitration_id, m.data[0]) for m in got] == [(0x200 + k, k) for k in range(1, 10)]
+        for k in range(300):  # a backlog bigger than one read
+            other.send(can.Message(arbitration_id=0x180 + k % 9, data=k.to_bytes(2, "little"), is_extended_id=False))
+        seen = []
+        while len(seen) < 300:
+            msg = base.recv(2.0)
+            assert msg is not None, f"only {len(seen)} of 300 frames arrived"
+            seen.append(int.from_bytes(bytes(msg.data), "little"))
+        assert seen == list(range(300))
+    finally:
+        base.shutdown()
         other.shutdown()

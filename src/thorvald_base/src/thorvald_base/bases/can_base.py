@@ -51,6 +51,7 @@ class BusCounters:
     reopened: int = 0
     relay_dropped: int = 0
     relay_refused: int = 0
+    unparsable: int = 0  # frames the interface could not parse
     last_error: str = ""
     extra: Dict[str, int] = field(default_factory=dict)
 
@@ -77,6 +78,11 @@ def open_bus(interface: str, channel: str, bitrate: int = DEFAULT_BITRATE):
     if interface == "virtual":
         kwargs["receive_own_messages"] = False
     try:
+        if interface == "slcan":
+            from ..can.slcan import BufferedSlcanBus  # noqa: PLC0415  (python-can 4.1 reads SLCAN bytewise)
+
+            del kwargs["interface"]
+            return BufferedSlcanBus(**kwargs)
         return can.Bus(**kwargs)
     except Exception as e:  # python-can raises what the interface's library raises
         raise ThorvaldBaseError(
@@ -111,6 +117,8 @@ class CanBase(BaseHandle):
         except ValueError as e:
             raise ParameterError(f"the robot's CAN devices: {e}") from None
         self.devices = [*self.batteries_, *self.controllers_, *self.ios]  # the original's routing order
+        # ids never clash (device_ids), so one lookup routes a frame as the original's search would
+        self.by_id = {can_id: d for d in self.devices for can_id in d.ids}
         self.relay_queue: Deque[Frame] = collections.deque()
         self.received_base: List[Frame] = []
         self.received_device: List[Frame] = []
@@ -254,8 +262,17 @@ class CanBase(BaseHandle):
 
     # ---- bus I/O -----------------------------------------------------------------------------
     def _send_all(self, frames: Sequence[Tuple[int, bytes]]) -> None:
-        for can_id, data in frames:
-            self._send(can_id, data)
+        batch = getattr(self.bus, "send_batch", None)  # one write for all (BufferedSlcanBus)
+        if batch is None or len(frames) < 2:
+            for can_id, data in frames:
+                self._send(can_id, data)
+            return
+        import can  # noqa: PLC0415
+
+        try:
+            batch([can.Message(arbitration_id=i, data=d, is_extended_id=False) for i, d in frames], timeout=0.05)
+        except Exception as e:  # bus-off, a full buffer, a port that went away
+            self._bus_error("send", e)
 
     def _send(self, can_id: int, data: bytes, extended: bool = False, remote: bool = False) -> None:
         import can  # noqa: PLC0415
@@ -277,6 +294,9 @@ class CanBase(BaseHandle):
         for _ in range(READ_LIMIT):
             try:
                 msg = self.bus.recv(timeout=0.0)
+            except (ValueError, IndexError):  # an interface's parser on a garbled frame (python-can's slcan)
+                self.counters.unparsable += 1
+                continue
             except Exception as e:  # the interface's own errors, whatever their class
                 self._bus_error("receive", e)
                 return
@@ -288,12 +308,11 @@ class CanBase(BaseHandle):
             self._route(Frame(msg.arbitration_id, bytes(msg.data), msg.is_extended_id, msg.is_remote_frame, time), time)
 
     def _route(self, frame: Frame, time: float) -> None:
-        if not frame.is_extended:
-            for device in self.devices:
-                if device.claim(frame.id, frame.data, time):
-                    self.received_base.append(frame)
-                    return
-        self.received_device.append(frame)
+        device = None if frame.is_extended else self.by_id.get(frame.id)
+        if device is not None and device.claim(frame.id, frame.data, time):
+            self.received_base.append(frame)
+        else:
+            self.received_device.append(frame)
 
     def _bus_error(self, what: str, error: Exception) -> None:
         if what == "send":
@@ -372,7 +391,7 @@ class CanBase(BaseHandle):
             "send errors": str(c.send_errors),
             "receive errors": str(c.receive_errors),
             "bus reopened": str(c.reopened),
-            "malformed frames": str(self.malformed_frames),
+            "malformed frames": str(self.malformed_frames + c.unparsable),
             "relayed frames dropped": str(c.relay_dropped),
             "relayed frames refused": str(c.relay_refused),
             "relay muted": str(self.muted),
