@@ -171,6 +171,7 @@ class BaseDriverNode:
             for relay in range(2):
                 rospy.Service(f"~io{board.id}_rl{relay}", SetBool, self._relay_service(board.id, relay))
         self._last_status_publish = None
+        self._link_logged = {}
         rospy.loginfo(
             "base_driver: %d drives, calculator %s, base %s, %.0f Hz, odom tf %s",
             len(self.config.drives),
@@ -344,13 +345,24 @@ class BaseDriverNode:
             )
         if link:
             level = DiagnosticStatus.ERROR if "closed" in link.get("bus", "") else DiagnosticStatus.OK
-            if level == DiagnosticStatus.OK and link.get("wheels stopped: lost"):
+            if level == DiagnosticStatus.OK and (link.get("wheels stopped: lost") or link.get("wrong script")):
                 level = DiagnosticStatus.ERROR
+            self.log_link_changes(link)
             statuses.append(conversions.diagnostic_status(f"{prefix}CAN bus", "can", level, link.get("bus", ""), link))
         if statuses:
             msg = DiagnosticArray(status=statuses)
             msg.header.stamp = stamp
             self.diagnostics_pub.publish(msg)
+
+    def log_link_changes(self, link):
+        """A warning when the hardware link's state changes (a bus error, lost devices, a wrong script)."""
+        for key in ("last error", "wheels stopped: lost", "wrong script"):
+            value = link.get(key)
+            if value and value != self._link_logged.get(key):
+                rospy.logwarn("base_driver: CAN: %s: %s", key, value)
+            if value is None and self._link_logged.get(key) and key == "wheels stopped: lost":
+                rospy.logwarn("base_driver: CAN: every device heard again: the wheels follow commands")
+            self._link_logged[key] = value
 
     def publish_odometry(self, odometry, stamp):
         if not odometry.valid:

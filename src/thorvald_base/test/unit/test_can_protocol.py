@@ -9,6 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from thorvald_base.can import protocol as pr
+from thorvald_base.can.dbc import main, robot_dbc
 from thorvald_model import load_robot_config
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -206,3 +207,29 @@ def test_decoders_take_any_payload(data):
             decode(data)
         except pr.MalformedFrame:
             assert len(data) != 8 or decode is pr.decode_tx_pdo4
+
+
+# ---- one robot's DBC file --------------------------------------------------------------------
+def test_a_robots_dbc_has_every_device_at_its_own_id(tmp_path):
+    config = load_robot_config(STD)
+    with open(pr.dbc_path()) as f:
+        text = robot_dbc(f.read(), config)
+    db = cantools.database.load_string(text)
+    nodes = sorted({d.node for d in config.drives})
+    batteries = [b.id for b in config.batteries if b.type == 1 and b.with_battery]
+    assert len(db.messages) == 9 * len(nodes) + 3 * len(batteries)
+    for n in nodes:
+        m = db.get_message_by_frame_id(pr.TX_PDO1 + n)
+        assert m.name == f"Roboteq_TxPDO1_node{n}"
+        assert m.decode(pr.encode_tx_pdo1(pr.TxPdo1(123, -4, 5678))) == {
+            "prop_rpm": 123,
+            "steer_rpm": -4,
+            "steer_counts": 5678,
+        }
+        assert db.get_message_by_frame_id(pr.RX_PDO3 + n).decode(pr.encode_pair(1, 1))["mode"] == "home"
+    for k in batteries:
+        assert db.get_message_by_frame_id(pr.BATTERY_TPDO3 + k).name == f"Battery_TPDO3_bat{k}"
+    out = tmp_path / "robot.dbc"
+    assert main([STD, "-o", str(out)]) == 0
+    assert out.read_text() == text
+    assert main([str(tmp_path / "missing.yaml")]) == 2

@@ -11,6 +11,8 @@ import os
 import can
 import pytest
 import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from thorvald_base.bases.can_base import CanBase
 from thorvald_base.bases.handle import Frame
@@ -230,3 +232,13 @@ def test_buses_that_cannot_open_give_one_line(interface, channel, message):
     with pytest.raises((ParameterError, ThorvaldBaseError), match=message) as info:
         CanBase.from_params(load_robot_config(STD), {"can_interface_type": interface, "can_interface_name": channel})
     assert "\n" not in str(info.value)
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.integers(0, 0x7FF), st.binary(min_size=0, max_size=8), st.booleans())
+def test_any_frame_is_routed_without_raising(can_id, data, extended):
+    handle = CanBase(load_robot_config(STD), bus=None)
+    handle._route(Frame(can_id, data, extended), 1.0)
+    base, device = handle.take_received()
+    assert len(base) + len(device) == 1
+    assert bool(base) == (not extended and can_id in handle.by_id)

@@ -400,6 +400,9 @@ class CanBase(BaseHandle):
             values["last error"] = c.last_error
         if self.stopped_for_lost:
             values["wheels stopped: lost"] = ", ".join(self.stopped_for_lost)
+        mismatches = [c.script_mismatch for c in self.controllers_ if c.script_mismatch]
+        if mismatches:
+            values["wrong script"] = "; ".join(mismatches)
         return values
 
     def controllers(self, time) -> List[ControllerInfo]:
@@ -434,6 +437,9 @@ class CanBase(BaseHandle):
                     temps=(float(c.tx3.max_temperature),) if c.tx3 else (),
                     status_flags=c.tx3.flags if c.tx3 else (),
                     motor_vars=motor_vars,
+                    drive_direction=c.homing_setup.drive_direction if c.homing_setup else 0,
+                    home_speed=c.homing_setup.home_speed if c.homing_setup else 0,
+                    home_count=c.homing_setup.home_count if c.homing_setup else 0,
                 )
             )
         return out

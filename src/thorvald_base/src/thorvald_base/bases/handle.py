@@ -68,6 +68,9 @@ class ControllerInfo:
     temps: Tuple[float, ...] = ()  # [degC]
     status_flags: Tuple[Tuple[str, bool], ...] = ()
     motor_vars: Tuple[Tuple[str, float, float, float, float], ...] = ()  # (type, speed, position, amps, power)
+    drive_direction: int = 0
+    home_speed: int = 0
+    home_count: int = 0
 
 
 @dataclass(frozen=True)
