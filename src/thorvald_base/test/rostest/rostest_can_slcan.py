@@ -17,6 +17,7 @@ import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from driver_testing import STARTUP_TIMEOUT, Topic, driver_service, driver_stream, twist
+from nav_msgs.msg import Odometry
 from std_srvs.srv import SetBool, Trigger
 
 from thorvald_msgs.msg import BaseState, CANFrame, ControllerArray
@@ -40,6 +41,7 @@ class CanSlcanTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.state = Topic("base_state", BaseState)
+        cls.odom = Topic("odometry/base_raw", Odometry)
         cls.controllers = Topic("motor_controller_data", ControllerArray)
         cls.diagnostics = Topic("/diagnostics", DiagnosticArray)
         cls.device_r = Topic("can_frames_device_r", CANFrame)
@@ -49,7 +51,8 @@ class CanSlcanTest(unittest.TestCase):
 
     def test_1_drives_follow_commands_over_the_bus(self):
         online = self.controllers.wait_for(
-            lambda m: len(m.controllers) == 4 and all(c.controller_mode == 3 for c in m.controllers),
+            # online, and each has sent its script version (once a second)
+            lambda m: len(m.controllers) == 4 and all(c.controller_mode == 3 and c.version for c in m.controllers),
             timeout=STARTUP_TIMEOUT,
             since=0,
         )
@@ -58,6 +61,16 @@ class CanSlcanTest(unittest.TestCase):
         self.assertEqual({c.version for c in online.controllers}, {"2.1.0"})
         self.cmd.send(twist(SPEED))
         self.assertIsNotNone(self.state.wait_for(all_at(SPEED), timeout=10.0), "the wheels never reached 0.5 m/s")
+        # odometry from the speeds and steering counts the controllers report
+        odom = self.odom.wait_for(lambda m: abs(m.twist.twist.linear.x - SPEED) < 0.01, timeout=5.0)
+        self.assertIsNotNone(odom, "odometry did not follow the command")
+        self.assertAlmostEqual(odom.twist.twist.angular.z, 0.0, delta=0.01)
+        self.cmd.send(twist(0.3, 0.0, 0.4))
+        turning = self.odom.wait_for(
+            lambda m: abs(m.twist.twist.linear.x - 0.3) < 0.01 and abs(m.twist.twist.angular.z - 0.4) < 0.01,
+            timeout=10.0,
+        )
+        self.assertIsNotNone(turning, "odometry did not follow a turning command")
 
     def test_2_a_silent_controller_stops_the_wheels_and_control_resumes(self):
         self.cmd.send(twist(SPEED))
