@@ -1,0 +1,48 @@
+"""Every launch file of thorvald_bringup loads in roslaunch (arguments, includes, the robot files
+they name), and each example robot has its <robot>_sim.launch bringing up that robot's file."""
+
+import glob
+import os
+
+import pytest
+import roslaunch.config
+import roslaunch.xmlloader
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+BRINGUP = os.path.join(HERE, "..", "src", "thorvald_bringup", "launch")
+ROBOTS = sorted(
+    os.path.basename(p) for p in glob.glob(os.path.join(HERE, "..", "src", "thorvald_model", "config", "*"))
+)
+
+
+def load(path, args=()):
+    config = roslaunch.config.ROSLaunchConfig()
+    loader = roslaunch.xmlloader.XmlLoader()
+    loader.load(path, config, argv=list(args), verbose=False)
+    return config
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_each_example_robot_has_its_sim_launch(robot):
+    config = load(os.path.join(BRINGUP, robot, f"{robot}_sim.launch"))
+    model = config.params["/thorvald_001/base_driver/robot_model"].value
+    assert model.endswith(os.path.join(robot, robot + ".yaml")) and os.path.isfile(model)
+    names = {n.name for n in config.nodes}
+    assert {"simulator", "base_driver", "twist_mux", "spawn_robot", "robot_state_publisher"} <= names
+
+
+def test_sim_launch_options():
+    config = load(
+        os.path.join(BRINGUP, "sim.launch"), ["with_teleoperation:=true", "with_rviz:=true", "robot_name:=r7"]
+    )
+    names = {(n.namespace, n.name) for n in config.nodes}
+    assert ("/r7/", "teleop_node") in names and ("/r7/", "joy_node") in names and ("/r7/", "rviz") in names
+    assert config.params["/r7/teleop_node/enable_button"].value == 4  # the xbox controller file
+
+
+def test_multi_sim_launch_has_four_robots_each_placed_in_world():
+    config = load(os.path.join(BRINGUP, "multi_sim.launch"))
+    for k in range(1, 5):
+        assert f"/robot_{k}/base_driver/robot_model" in config.params
+        assert config.params[f"/world_to_robot_{k}_odom/child"].value == f"robot_{k}/odom"
+    assert config.params["/simulator/world"].value == "tarmac_gravel"
