@@ -46,3 +46,23 @@ def test_multi_sim_launch_has_four_robots_each_placed_in_world():
         assert f"/robot_{k}/base_driver/robot_model" in config.params
         assert config.params[f"/world_to_robot_{k}_odom/child"].value == f"robot_{k}/odom"
     assert config.params["/simulator/world"].value == "tarmac_gravel"
+
+
+def test_robot_launch_drives_the_real_base_over_can():
+    std = os.path.join(
+        HERE, "..", "src", "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml"
+    )
+    config = load(
+        os.path.join(BRINGUP, "robot.launch"),
+        [f"robot_model:={std}", "can_interface_type:=slcan", "can_interface_name:=/dev/ttyACM0", "robot_name:=t8"],
+    )
+    p = {k: v.value for k, v in config.params.items()}
+    assert p["/t8/base_driver/simple_sim"] is False
+    assert (p["/t8/base_driver/can_interface_type"], p["/t8/base_driver/can_interface_name"]) == (
+        "slcan",
+        "/dev/ttyACM0",
+    )
+    assert p["/t8/base_driver/tf_prefix"] == "t8/" and p["/t8/base_driver/odom_frame_id"] == "t8/odom"
+    names = {n.name for n in config.nodes}
+    assert {"base_driver", "twist_mux", "robot_state_publisher", "joy_node", "teleop_node"} <= names
+    assert "simulator" not in names
