@@ -92,11 +92,31 @@ def free_port(first):
     raise RuntimeError(f"no free port in {first}..{first + 99}")
 
 
-def cpu_seconds(pid):
-    """utime + stime [s] of a process (/proc/<pid>/stat fields 14 and 15)."""
-    with open(f"/proc/{pid}/stat") as f:
-        fields = f.read().rsplit(")", 1)[1].split()
+def cpu_seconds(pid, missing=None):
+    """utime + stime [s] of a process (/proc/<pid>/stat fields 14 and 15); missing if it has gone
+    (None: raise)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+    except OSError:
+        if missing is None:
+            raise
+        return missing
     return (int(fields[11]) + int(fields[12])) / CLK_TCK
+
+
+def start_master(procs, log, port, node_name, master_only=False):
+    """roscore (or a bare rosmaster) on port, and this process as node_name on it; the master's process."""
+    os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
+    command = ["rosmaster", "--core", "-p", str(port)] if master_only else ["roscore", "-p", str(port)]
+    proc = procs.start(command, log)
+    deadline = time.time() + 60
+    while not rosgraph.Master("/bench").is_online():
+        if time.time() > deadline:
+            raise RuntimeError(f"{command[0]} did not come up")
+        time.sleep(0.2)
+    rospy.init_node(node_name, disable_signals=True)
+    return proc
 
 
 def percentile(values, q):
@@ -283,19 +303,12 @@ def main():
 
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))  # through the finally below: stop every process
     port = free_port(args.port)
-    os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
     procs = Processes()
     log = open(os.devnull, "w")
     load_before = os.getloadavg()[0]
     rows = []
     try:
-        procs.start(["roscore", "-p", str(port)], log)
-        deadline = time.time() + 60
-        while not rosgraph.Master("/bench").is_online():
-            if time.time() > deadline:
-                raise RuntimeError("roscore did not come up")
-            time.sleep(0.2)
-        rospy.init_node("bench_base_driver", disable_signals=True)
+        start_master(procs, log, port, "bench_base_driver")
         bench = Bench(procs, log)
         print(f"roscore on port {port}; {os.cpu_count()} cores, load average {load_before:.2f} at start", flush=True)
 

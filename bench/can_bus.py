@@ -30,9 +30,8 @@ import threading
 import time
 
 import can
-import rosgraph
 import rospy
-from base_driver import HELD, NINE, Bench, Processes, free_port  # the base_driver benchmark's tools
+from base_driver import HELD, NINE, Bench, Processes, free_port, start_master  # the base_driver benchmark's tools
 from nav_msgs.msg import Odometry
 
 from thorvald_base.can.slcan import BufferedSlcanBus
@@ -156,7 +155,6 @@ def main():
 
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))  # through the finally below: stop every process
     port = free_port(args.port)
-    os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
     procs = Processes()
     log = open(os.devnull, "w")
     links = tempfile.mkdtemp(prefix="thorvald_can_bench_")
@@ -164,13 +162,7 @@ def main():
     implement = None
     ok = True
     try:
-        procs.start(["roscore", "-p", str(port)], log)
-        deadline = time.time() + 60
-        while not rosgraph.Master("/bench").is_online():
-            if time.time() > deadline:
-                raise RuntimeError("roscore did not come up")
-            time.sleep(0.2)
-        rospy.init_node("bench_can", disable_signals=True)
+        start_master(procs, log, port, "bench_can")
         bench = Bench(procs, log)
         procs.start(
             ["rosrun", "thorvald_sim", "can_emulator", bench.robot_file(NINE), "--ports", "2", "--link-dir", links], log

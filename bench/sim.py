@@ -19,17 +19,17 @@ Target: four robots at least 3 times real time on this 2-core machine.
 import argparse
 import os
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
 import threading
 import time
 
+from base_driver import Processes, cpu_seconds, free_port, start_master  # the base_driver benchmark's tools
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 STD = os.path.join(ROOT, "src", "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
 SPACING = 4.0  # [m] between robots
-TICK = os.sysconf("SC_CLK_TCK")
 TARGET_OVERHEAD = 1.25
 TARGET_FOUR = 3.0
 
@@ -111,21 +111,6 @@ def core(n: int, seconds: float):
         p.disconnect(c)
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def cpu_seconds(pid):
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            fields = f.read().rsplit(")", 1)[1].split()
-        return (int(fields[11]) + int(fields[12])) / TICK
-    except OSError:
-        return 0.0
-
-
 def node(n: int, seconds: float, port: int):
     """(real-time factor, simulator CPU [s] per simulated second, all nodes' CPU share [cores]).
 
@@ -180,13 +165,13 @@ def node(n: int, seconds: float, port: int):
         every = children(proc.pid)  # roslaunch starts every node in a session of its own
         simulator = [pid for pid in every if "/simulator" in cmdline(pid).split(" __")[0]]
         t0, w0 = clock["t"], time.perf_counter()
-        c0 = sum(cpu_seconds(p) for p in simulator)
-        a0 = sum(cpu_seconds(p) for p in every)
+        c0 = sum(cpu_seconds(p, missing=0.0) for p in simulator)
+        a0 = sum(cpu_seconds(p, missing=0.0) for p in every)
         while clock["t"] - t0 < seconds and time.perf_counter() - w0 < 20 * seconds:
             time.sleep(0.1)
         t1, w1 = clock["t"], time.perf_counter()
-        c1 = sum(cpu_seconds(p) for p in simulator)
-        a1 = sum(cpu_seconds(p) for p in every)
+        c1 = sum(cpu_seconds(p, missing=0.0) for p in simulator)
+        a1 = sum(cpu_seconds(p, missing=0.0) for p in every)
         simulated = t1 - t0
         return simulated / (w1 - w0), (c1 - c0) / simulated, (a1 - a0) / (w1 - w0)
     finally:
@@ -217,25 +202,6 @@ def cmdline(pid):
         return ""
 
 
-def master(port: int):
-    """A master of the benchmark's own, and this process as a node on it."""
-    os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
-    proc = subprocess.Popen(
-        ["rosmaster", "--core", "-p", str(port)],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        start_new_session=True,
-    )
-    import rosgraph  # noqa: PLC0415
-    import rospy  # noqa: PLC0415
-
-    deadline = time.time() + 30
-    while not rosgraph.is_master_online() and time.time() < deadline:
-        time.sleep(0.1)
-    rospy.init_node("bench_sim", anonymous=True, disable_signals=True)
-    return proc
-
-
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated seconds measured per case")
@@ -247,9 +213,11 @@ def main() -> int:
         f" {'overhead':>9} {'all nodes':>10}"
     )
     results = {}
-    port = free_port()
-    rosmaster = master(port)
+    procs = Processes()
+    log = open(os.devnull, "w")
     try:
+        port = free_port(11399)
+        start_master(procs, log, port, "bench_sim", master_only=True)
         for n in args.robots:
             raw_rtf, raw_cpu = raw(n, args.seconds)
             core_cpu = core(n, args.seconds)
@@ -264,8 +232,8 @@ def main() -> int:
         import rospy  # noqa: PLC0415
 
         rospy.signal_shutdown("done")
-        rosmaster.terminate()
-        rosmaster.wait(timeout=30)
+        procs.stop_all()
+        log.close()
     ok = True
     worst = max(results[n][3] / results[n][2] for n in results)
     verdict = worst <= TARGET_OVERHEAD

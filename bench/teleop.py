@@ -20,9 +20,8 @@ import tempfile
 import threading
 import time
 
-import rosgraph
 import rospy
-from base_driver import Processes, free_port, percentile  # the base_driver benchmark's tools
+from base_driver import Processes, free_port, percentile, start_master  # the base_driver benchmark's tools
 from geometry_msgs.msg import Twist
 
 TARGET_MS = 5.0
@@ -40,7 +39,6 @@ def main():
     args = parser.parse_args()
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))
     port = free_port(args.port)
-    os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
     procs = Processes()
     log = open(os.devnull, "w")
     folder = tempfile.mkdtemp(prefix="thorvald_teleop_bench_")
@@ -48,13 +46,7 @@ def main():
     os.mkfifo(fifo)
     writer = None
     try:
-        procs.start(["roscore", "-p", str(port)], log)
-        deadline = time.time() + 60
-        while not rosgraph.Master("/bench").is_online():
-            if time.time() > deadline:
-                raise RuntimeError("roscore did not come up")
-            time.sleep(0.2)
-        rospy.init_node("bench_teleop", disable_signals=True)
+        start_master(procs, log, port, "bench_teleop")
         arrivals = []
         lock = threading.Lock()
 

@@ -58,6 +58,7 @@ from thorvald_msgs.srv import (
 
 from . import conversions
 from .bases import create_base_handle, handle_name
+from .bases.handle import BATTERY_LOST, MODE_LOST_CONNECTION
 from .core import DEFAULT_TWIST_COVARIANCE, BaseDriverCore, PoseCovariance
 from .errors import ParameterError, ThorvaldBaseError
 from .plugins import load_calculator
@@ -325,11 +326,11 @@ class BaseDriverNode:
         ns = rospy.get_namespace().strip("/")
         prefix = f"base_driver ({ns}): " if ns else "base_driver: "
         for c in controllers:
-            level = lost if c.mode == 4 else DiagnosticStatus.OK
+            level = lost if c.mode == MODE_LOST_CONNECTION else DiagnosticStatus.OK
             flags = [name for name, on in c.status_flags if on]
             if level == DiagnosticStatus.OK and flags:
                 level = DiagnosticStatus.WARN
-            message = "lost connection" if c.mode == 4 else (", ".join(flags) if flags else "ok")
+            message = "lost connection" if c.mode == MODE_LOST_CONNECTION else (", ".join(flags) if flags else "ok")
             values = {"mode": c.mode, "battery volts": f"{c.battery_volts:.1f}", "version": c.version}
             statuses.append(
                 conversions.diagnostic_status(
@@ -337,8 +338,8 @@ class BaseDriverNode:
                 )
             )
         for b in batteries:
-            level = lost if b.state == 2 else (DiagnosticStatus.WARN if b.alarms else DiagnosticStatus.OK)
-            message = "lost connection" if b.state == 2 else (", ".join(b.alarms) if b.alarms else "ok")
+            level = lost if b.state == BATTERY_LOST else (DiagnosticStatus.WARN if b.alarms else DiagnosticStatus.OK)
+            message = "lost connection" if b.state == BATTERY_LOST else (", ".join(b.alarms) if b.alarms else "ok")
             values = {"voltage": f"{b.voltage:.2f}", "state of charge": f"{b.state_of_charge:.0f} %"}
             statuses.append(
                 conversions.diagnostic_status(f"{prefix}battery {b.id}", f"battery {b.id}", level, message, values)

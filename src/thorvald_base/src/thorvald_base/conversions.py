@@ -28,6 +28,7 @@ from thorvald_msgs.msg import (
 )
 
 from .bases import BatteryInfo, ControllerInfo, Frame, IoInfo, MeasuredDrive
+from .bases.handle import BATTERY_LOST
 from .kinematics import DriveCommand, OdometryResult
 
 
@@ -232,8 +233,8 @@ def battery_state_msg(stamp, frame_id: str, b: BatteryInfo) -> BatteryState:
     msg.percentage = b.state_of_charge / 100.0
     msg.temperature = max(b.temperatures) if b.temperatures else math.nan
     msg.power_supply_technology = BatteryState.POWER_SUPPLY_TECHNOLOGY_LION
-    msg.present = b.state != 2
-    if b.state == 2:
+    msg.present = b.state != BATTERY_LOST
+    if b.state == BATTERY_LOST:
         msg.power_supply_status = BatteryState.POWER_SUPPLY_STATUS_UNKNOWN
         msg.power_supply_health = BatteryState.POWER_SUPPLY_HEALTH_UNKNOWN
     else:

@@ -29,6 +29,7 @@ STATUS_PERIOD = 1.0  # [s] TPDO4 (homing setup, script, PPRs), heartbeat, batter
 SCRIPT_VERSION = (2, 1, 0)  # major, minor, patch the emulated script reports
 NOMINAL_VOLTS = 48.0
 CAPACITY_AH = 100.0
+RX_MESSAGES = {0x200: "Roboteq_RxPDO1", 0x300: "Roboteq_RxPDO2", 0x400: "Roboteq_RxPDO3", 0x500: "Roboteq_RxPDO4"}
 
 
 def load_dbc(path: Optional[str] = None):
@@ -226,15 +227,9 @@ class CanEmulator:
             self._handle(msg.arbitration_id, bytes(msg.data))
 
     def _handle(self, can_id: int, data: bytes) -> None:
-        for node, c in self.controllers.items():
-            name = {
-                0x200: "Roboteq_RxPDO1",
-                0x300: "Roboteq_RxPDO2",
-                0x400: "Roboteq_RxPDO3",
-                0x500: "Roboteq_RxPDO4",
-            }.get(can_id - node)
-            if name is None or len(data) != 8:
-                continue
+        name = RX_MESSAGES.get(can_id & 0x780)  # CANopen: function code + node id (1..127)
+        c = self.controllers.get(can_id & 0x7F) if name else None
+        if c is not None and len(data) == 8:
             fields = self._messages[name].decode(data, decode_choices=False)
             if name == "Roboteq_RxPDO1":
                 c.commands += 1
@@ -322,18 +317,7 @@ class CanEmulator:
 
     def _tpdo3(self, c: EmulatedController) -> None:
         volts = self._battery_volts()
-        values = {
-            name: 0
-            for name in (
-                "prop_enc_fail",
-                "steer_enc_fail",
-                "alignment_fail",
-                "power_stage_off",
-                "stall_detected",
-                "homing_reached_max_count",
-                "illegal_command",
-            )
-        }
+        values = {s.name: 0 for s in self._messages["Roboteq_TxPDO3"].signals if s.length == 1}  # no fault flag
         values.update(
             controller_ok=1,
             max_temperature=35,

@@ -9,19 +9,16 @@ for a message with a deadline; "nothing else was published" is checked by the ne
 import json
 import os
 import queue
-import signal
-import socket
 import subprocess
 import sys
 import threading
 import time
-import xmlrpc.client
 
 import pytest
+from teleop_test_helpers import START, stop_group
 
 from thorvald_teleop.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
 
-STARTUP = 30.0  # [s] for a process to come up on a busy machine
 TIMEOUT = 10.0  # [s] for a message that should come
 OK, ERROR = 0, 2
 
@@ -55,52 +52,6 @@ while not rospy.is_shutdown():
         said = True
     rate.sleep()
 """
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def stop(proc):
-    """SIGINT to the process group (rospy and roscore shut down on it), SIGKILL if it lingers."""
-    if proc.poll() is None:
-        os.killpg(proc.pid, signal.SIGINT)
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait(timeout=10)
-
-
-@pytest.fixture(scope="module")
-def ros_env(tmp_path_factory):
-    """The environment of processes on a new ROS master (roscore on a free port)."""
-    port = free_port()
-    home = tmp_path_factory.mktemp("ros_home")
-    env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}", ROS_HOME=str(home), PYTHONUNBUFFERED="1")
-    env.pop("ROS_NAMESPACE", None)
-    log = open(home / "roscore.log", "w")
-    core = subprocess.Popen(
-        ["roscore", "-p", str(port)], env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True
-    )
-    try:
-        master = xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"])
-        deadline = time.monotonic() + STARTUP
-        while True:
-            assert core.poll() is None, (home / "roscore.log").read_text()
-            try:
-                if master.getSystemState("/test")[0] == 1:
-                    break
-            except OSError:
-                pass
-            assert time.monotonic() < deadline, "the ROS master did not come up"
-            time.sleep(0.1)
-        yield env
-    finally:
-        stop(core)
-        log.close()
 
 
 class Listener:
@@ -137,7 +88,7 @@ class Listener:
             self.connected = True
         return True
 
-    def wait_connected(self, timeout=STARTUP):
+    def wait_connected(self, timeout=START):
         deadline = time.monotonic() + timeout
         while not self.connected:
             assert self._take(deadline), "the listener never connected to joy_node's joy topic"
@@ -173,7 +124,7 @@ class Listener:
             )
 
     def close(self):
-        stop(self.proc)
+        stop_group(self.proc)
 
 
 class JoyNode:
@@ -198,7 +149,7 @@ class JoyNode:
         assert self.proc.poll() is None, "joy_node exited:\n" + self.output()[-3000:]
 
     def stop(self):
-        stop(self.proc)
+        stop_group(self.proc)
         self.log.close()
 
 

@@ -14,15 +14,14 @@ import queue
 import shlex
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import termios
 import threading
 import time
-import xmlrpc.client
 
 import pytest
+from teleop_test_helpers import START, children, poll, stop_group
 
 from thorvald_teleop.keyboard_node import RawTerminal
 
@@ -33,7 +32,6 @@ pytestmark = pytest.mark.skipif(
 SPEED = 0.5
 KEY_TIMEOUT = 0.6
 RATE = 20.0
-START = 30.0  # deadline for a process to start [s]
 WAIT = 5.0  # deadline for an expected message [s]
 SILENCE = 0.8  # after a stop the node must stay silent this long (longer than the mux's 0.5 s timeout)
 FORWARD = [SPEED, 0, 0, 0, 0, 0]
@@ -60,89 +58,6 @@ while True:
         print(json.dumps({"connections": n}), flush=True)
     time.sleep(0.02)
 """
-
-
-def poll(predicate, timeout, what, interval=0.02):
-    deadline = time.monotonic() + timeout
-    while True:
-        value = predicate()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-        time.sleep(interval)
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def children(pid):
-    out = subprocess.run(["pgrep", "-P", str(pid)], capture_output=True, text=True)
-    return [int(p) for p in out.stdout.split()]
-
-
-def stop_group(proc):
-    """Ends a process started in its own session, and its children (roscore's rosmaster and rosout run in
-    process groups of their own: roscore ends them on SIGINT; they are killed if it does not)."""
-    kids = children(proc.pid)
-    if proc.poll() is None:
-        try:
-            os.killpg(proc.pid, signal.SIGINT)
-            proc.wait(timeout=10)
-            return
-        except subprocess.TimeoutExpired:
-            pass
-        except ProcessLookupError:
-            proc.wait(timeout=10)
-            return
-    for pid in kids:
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-    try:
-        os.killpg(proc.pid, signal.SIGKILL)
-    except ProcessLookupError:
-        pass
-    proc.wait(timeout=10)
-
-
-@pytest.fixture(scope="module")
-def ros_env(tmp_path_factory):
-    """A ROS master of this module's own; yields the environment to run processes with."""
-    home = tmp_path_factory.mktemp("ros_home")
-    port = free_port()
-    env = dict(os.environ)
-    env.pop("TMUX", None)
-    env.pop("ROS_NAMESPACE", None)
-    env.update(ROS_MASTER_URI=f"http://127.0.0.1:{port}", ROS_HOME=str(home), ROS_LOG_DIR=str(home / "log"))
-    with open(home / "roscore.out", "w") as out:
-        core = subprocess.Popen(
-            ["roscore", "-p", str(port)],
-            env=env,
-            stdin=subprocess.DEVNULL,
-            stdout=out,
-            stderr=subprocess.STDOUT,
-            start_new_session=True,
-        )
-    try:
-
-        def master_up():
-            assert core.poll() is None, (home / "roscore.out").read_text()
-            try:
-                with xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"]) as master:
-                    master.getPid("/test")
-                return True
-            except OSError:
-                return False
-
-        poll(master_up, START, "the ROS master")
-        yield env
-    finally:
-        stop_group(core)
 
 
 class Listener:

@@ -14,14 +14,19 @@ Parameters (base_driver's private ones): ``can_interface_type`` (any python-can 
 import collections
 import math
 import time as wall
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Deque, Dict, List, Optional, Sequence, Tuple
+
+import can
 
 from ..can import protocol as pr
 from ..can.devices import Battery, IoBoard, MotorController
 from ..errors import ParameterError, ThorvaldBaseError
 from ..kinematics import DriveCommand
 from .handle import (
+    BATTERY_ALARM,
+    BATTERY_LOST,
+    BATTERY_OK,
     MODE_DRIVE,
     MODE_HOME,
     MODE_LOST_CONNECTION,
@@ -53,13 +58,10 @@ class BusCounters:
     relay_refused: int = 0
     unparsable: int = 0  # frames the interface could not parse
     last_error: str = ""
-    extra: Dict[str, int] = field(default_factory=dict)
 
 
 def open_bus(interface: str, channel: str, bitrate: int = DEFAULT_BITRATE):
     """A python-can bus; ThorvaldBaseError with one clear line when it cannot be opened."""
-    import can  # noqa: PLC0415  (only the CAN base needs python-can)
-
     if interface in UNPUBLISHED_INTERFACES:
         raise ParameterError(
             f"~can_interface_type: {interface!r}: the original enclosure PCB's protocol was never published; "
@@ -267,16 +269,12 @@ class CanBase(BaseHandle):
             for can_id, data in frames:
                 self._send(can_id, data)
             return
-        import can  # noqa: PLC0415
-
         try:
             batch([can.Message(arbitration_id=i, data=d, is_extended_id=False) for i, d in frames], timeout=0.05)
         except Exception as e:  # bus-off, a full buffer, a port that went away
             self._bus_error("send", e)
 
     def _send(self, can_id: int, data: bytes, extended: bool = False, remote: bool = False) -> None:
-        import can  # noqa: PLC0415
-
         if self.bus is None and not self._try_reopen():
             self.counters.send_errors += 1
             return
@@ -305,7 +303,7 @@ class CanBase(BaseHandle):
             if msg.is_error_frame:
                 self.counters.receive_errors += 1
                 continue
-            self._route(Frame(msg.arbitration_id, bytes(msg.data), msg.is_extended_id, msg.is_remote_frame, time), time)
+            self._route(Frame(msg.arbitration_id, bytes(msg.data), msg.is_extended_id, msg.is_remote_frame), time)
 
     def _route(self, frame: Frame, time: float) -> None:
         device = None if frame.is_extended else self.by_id.get(frame.id)
@@ -352,7 +350,7 @@ class CanBase(BaseHandle):
         for b in self.batteries_:
             t1, t2, t3 = b.tpdo1, b.tpdo2, b.tpdo3
             alarms = pr.battery_alarm_names(t1.alarms) if t1 else ()
-            state = 2 if not b.online(time) else (1 if alarms else 0)
+            state = BATTERY_LOST if not b.online(time) else (BATTERY_ALARM if alarms else BATTERY_OK)
             temps = (t1.temperatures if t1 else ()) + (t2.temperatures if t2 else ())
             out.append(
                 BatteryInfo(

@@ -22,6 +22,11 @@ MODE_HOME = 1
 MODE_ONLINE = 3
 MODE_LOST_CONNECTION = 4
 
+# BatteryInfo.state, as battery_data reports it.
+BATTERY_OK = 0
+BATTERY_ALARM = 1
+BATTERY_LOST = 2
+
 
 @dataclass(frozen=True)
 class MeasuredDrive:
@@ -41,7 +46,7 @@ class BatteryInfo:
     """One battery as battery_data reports it (thorvald_msgs/BatteryData)."""
 
     id: int
-    state: int  # 0 ok, 1 alarm, 2 lost connection
+    state: int  # BATTERY_OK, BATTERY_ALARM, BATTERY_LOST
     state_of_charge: float  # [%]
     state_of_health: float  # [%]
     voltage: float  # [V]
@@ -92,7 +97,6 @@ class Frame:
     data: bytes
     is_extended: bool = False
     is_remote: bool = False
-    time: float = 0.0
 
 
 class BaseHandle:
