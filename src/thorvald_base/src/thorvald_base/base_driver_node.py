@@ -262,8 +262,20 @@ class BaseDriverNode:
     # ---- the loop ----------------------------------------------------------------------------
     def spin(self):
         rate = rospy.Rate(self.rate)
+        last = None
         while not rospy.is_shutdown():
             now = rospy.Time.now()
+            if now == last:
+                # On simulated time a late cycle's rate.sleep() returns at once, before /clock moved:
+                # one cycle per instant, not two identical ones.
+                try:
+                    rospy.sleep(0.5 / self.rate)
+                except rospy.ROSTimeMovedBackwardsException:
+                    last = None
+                except rospy.ROSInterruptException:
+                    break
+                continue
+            last = now
             with self.lock:
                 if self.core.closed:
                     break

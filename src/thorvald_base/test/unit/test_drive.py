@@ -72,6 +72,19 @@ def test_never_commands_beyond_str_lim(str_lim, steps):
             assert c.speed * math.sin(c.steering) == pytest.approx(speed * math.sin(p), abs=1e-9)
 
 
+@pytest.mark.parametrize("noise", [-1e-3, -1e-6, 0.0, 1e-6, 1e-3])
+def test_a_crab_from_straight_ahead_turns_every_wheel_the_same_way_whatever_the_encoder_noise(noise):
+    # 90 degrees from a wheel measured at +-noise: the original's strict |p - a| > pi/2 let the sign of
+    # the noise choose between +90 forward and -90 reversed, wheel by wheel.
+    for p in (math.pi / 2, -math.pi / 2):
+        inv = SteeringInverter(3.078027759)
+        assert inv.apply(DriveCommand(p, 1.0), noise) == DriveCommand(p, 1.0)
+    # a real reversal still inverts: 92 degrees of travel
+    inv = SteeringInverter(3.078027759)
+    c = inv.apply(DriveCommand(math.radians(92), 1.0), 0.0)
+    assert (c.steering, c.speed) == pytest.approx((math.radians(-88), -1.0))
+
+
 def test_steering_near_the_stop_goes_the_other_way():
     # str_lim 176.4 degrees; the calculator asks for 179 degrees, measured 170 (travel 9 degrees,
     # not inverted by the hysteresis) -> beyond the stop, so the wheel points at -1 degree reversed.

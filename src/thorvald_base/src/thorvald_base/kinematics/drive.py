@@ -22,6 +22,11 @@ from .types import DriveCommand, DriveState
 NEVER_INVERT_BELOW = math.pi / 8
 INVERT_ABOVE = math.pi / 2
 UNINVERT_BELOW = math.pi / 4
+# [rad] (1 degree): a command this close to the INVERT_ABOVE threshold is not inverted. A crab from
+# straight ahead asks every wheel for exactly 90 degrees of travel; with the original's strict test,
+# encoder noise of either sign decided it wheel by wheel, so some wheels turned left and some right,
+# scrubbing against each other (seen in the simulator as a false turn in odometry: 0.6 m of end point).
+INVERT_TIE = math.radians(1.0)
 MAX_SIM_DT = 0.5  # [s]: a longer step is a pause; the simulated drive does not move (the original's rule)
 
 
@@ -41,7 +46,7 @@ class SteeringInverter:
         a = measured_steering
         if abs(p) < NEVER_INVERT_BELOW:
             self.inverted = False
-        elif abs(p - a) > INVERT_ABOVE and not self.inverted:
+        elif abs(p - a) > INVERT_ABOVE + INVERT_TIE and not self.inverted:
             self.inverted = True
         elif abs(p - a) < UNINVERT_BELOW and self.inverted:
             self.inverted = False
