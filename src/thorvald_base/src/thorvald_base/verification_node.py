@@ -1,12 +1,18 @@
 """The ``verification_drive`` node: drives the paper's verification manoeuvre on simulated time.
 
-It owns the simulated clock: it publishes ``/clock`` (so run it with ``/use_sim_time`` true),
-``~speedup`` times faster than real time, publishes the planned twists on ``cmd_vel`` (remap it to
-an input of twist_mux, e.g. ``nav_vel``), records ``odometry/base_raw`` and prints the report.
+It publishes the planned twists on ``cmd_vel`` (remap it to an input of twist_mux, e.g.
+``nav_vel``), records ``odometry/base_raw`` and prints the report. Run it with ``/use_sim_time``
+true. With ``~own_clock`` true (the default, for base_driver's own simulated drives) it owns the
+simulated clock: it publishes ``/clock`` ``~speedup`` times faster than real time. With
+``~own_clock`` false it follows the clock of a simulator (thorvald_sim), which sets the pace.
 
-Parameters: ``~robot_model`` (the robot's YAML, for the plan and the report), ``~speedup``
-(default 5), ``~clock_step`` [s] of simulated time per /clock message (default 0.005),
-``~command_rate`` [Hz] (default 20), ``~startup_timeout`` [s] of wall time (default 30).
+Parameters: ``~robot_model`` (the robot's YAML, for the plan and the report), ``~own_clock``
+(default true), ``~speedup`` (default 5), ``~clock_step`` [s] of simulated time per /clock message
+(default 0.005), ``~command_rate`` [Hz] (default 20), ``~startup_timeout`` [s] of wall time
+(default 30), ``~command_subscribers`` (default 1: twist_mux; 2 when ``rosbag record`` must hear
+the commands from the first one), ``~ready_topic`` (an Odometry topic that must publish before the
+drive starts, e.g. ``odometry/gazebo``: the robot is in the simulator; default none), ``~settle``
+[s] of simulated time standing still before and after the manoeuvre (default 1).
 """
 
 import os
@@ -32,8 +38,15 @@ class VerificationDrive:
         self.step = float(rospy.get_param("~clock_step", 0.005))
         self.command_period = 1.0 / float(rospy.get_param("~command_rate", 20.0))
         self.startup_timeout = float(rospy.get_param("~startup_timeout", 30.0))
+        self.own_clock = bool(rospy.get_param("~own_clock", True))
+        self.command_subscribers = int(rospy.get_param("~command_subscribers", 1))
+        self.settle = float(rospy.get_param("~settle", 1.0))
+        ready_topic = str(rospy.get_param("~ready_topic", ""))
+        self.ready = not ready_topic
+        if ready_topic:
+            self.ready_sub = rospy.Subscriber(ready_topic, Odometry, self.on_ready, queue_size=1)
         self.description, self.plan = plan_for(self.config)
-        self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10)
+        self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10) if self.own_clock else None
         self.cmd_pub = rospy.Publisher("cmd_vel", TwistMsg, queue_size=10)
         self.points = []
         self.recording = False
@@ -47,20 +60,47 @@ class VerificationDrive:
             p = msg.pose.pose.position
             self.points.append((p.x, p.y))
 
+    def on_ready(self, _msg):
+        self.ready = True
+
     def tick(self):
-        self.sim_time += self.step
-        self.clock_pub.publish(Clock(rospy.Time.from_sec(self.sim_time)))
-        time.sleep(self.step / self.speedup)
+        if self.own_clock:
+            self.sim_time += self.step
+            self.clock_pub.publish(Clock(rospy.Time.from_sec(self.sim_time)))
+            time.sleep(self.step / self.speedup)
+            return
+        # the simulator's clock: rospy wakes us when /clock passes the next step (roslaunch stops us
+        # if the simulator dies: it is required)
+        rospy.sleep(self.sim_time + self.step - rospy.get_time())
+        self.sim_time = rospy.get_time()
+
+    def settle_for(self, seconds):
+        end = self.sim_time + seconds
+        while self.sim_time < end and not rospy.is_shutdown():
+            self.tick()
 
     def run(self):
         # Let time run until base_driver publishes odometry and twist_mux listens to our commands.
         deadline = time.time() + self.startup_timeout
-        while not (self.odom_seen and self.cmd_pub.get_num_connections() > 0):
+        if not self.own_clock:
+            while rospy.get_time() == 0.0:
+                if time.time() > deadline or rospy.is_shutdown():
+                    raise RuntimeError("no /clock: the simulator did not come up")
+                time.sleep(0.01)
+            self.sim_time = rospy.get_time()
+        while not (self.ready and self.odom_seen and self.cmd_pub.get_num_connections() >= self.command_subscribers):
             if time.time() > deadline or rospy.is_shutdown():
-                raise RuntimeError("base_driver or twist_mux did not come up (no odometry/base_raw or no mux input)")
+                raise RuntimeError(
+                    "the robot did not come up: odometry/base_raw {}, ready topic {}, {} of {} subscribers of the "
+                    "commands".format(
+                        "heard" if self.odom_seen else "silent",
+                        "heard" if self.ready else "silent",
+                        self.cmd_pub.get_num_connections(),
+                        self.command_subscribers,
+                    )
+                )
             self.tick()
-        for _ in range(int(1.0 / self.step)):  # one simulated second standing still
-            self.tick()
+        self.settle_for(self.settle)  # standing still
         self.points = []
         self.recording = True
         start_sim, start_wall = self.sim_time, time.time()
@@ -77,8 +117,7 @@ class VerificationDrive:
                 self.cmd_pub.publish(msg)
                 next_command += self.command_period
             self.tick()
-        for _ in range(int(1.0 / self.step)):  # let the robot come to rest
-            self.tick()
+        self.settle_for(self.settle)  # let the robot come to rest
         self.recording = False
         return report(
             self.name,

@@ -11,7 +11,7 @@ import os
 import subprocess
 import sys
 
-PACKAGES = ["thorvald_base", "thorvald_model", "thorvald_sim", "thorvald_teleop"]
+PACKAGES = ["thorvald_base", "thorvald_bringup", "thorvald_model", "thorvald_sim", "thorvald_teleop"]
 # The modules whose job is ROS or physics, and why; everything else must be pure.
 NOT_PURE = {
     "thorvald_base.base_driver_node": "a node",
@@ -26,6 +26,7 @@ NOT_PURE = {
     "thorvald_base.conversions": "the one module that builds messages",
     "thorvald_base.msg": "aliases of thorvald_msgs for code written for the original",
     "thorvald_base.srv": "aliases of thorvald_msgs for code written for the original",
+    "thorvald_bringup.report_bag": "reads a rosbag, whose messages are genpy's",
     "thorvald_sim.scene": "the simulator's physics (pybullet)",
     "thorvald_sim.robot": "the simulator's physics (pybullet)",
     "thorvald_sim.simulation": "the simulator's physics (pybullet)",

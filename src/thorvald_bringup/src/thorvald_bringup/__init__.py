@@ -1,0 +1,1 @@
+"""thorvald_bringup: launch files for real and simulated robots, and the paper's odometry report."""

@@ -1,0 +1,249 @@
+"""The paper's odometry verification (section 3.3.2), as numbers: pure, from recorded series.
+
+A drive is recorded as the commands, base_driver's odometry (``odometry/base_raw``), ground truth
+(``odometry/gazebo``) and base_driver's measured drive states (``base_state``). Both odometry
+estimators are replayed from the same drive states through the calculator base_driver uses (the
+one of thorvald_base, loaded by its plugin name), so they are compared on one drive; the replayed
+``lsq`` must agree with what base_driver published live, which checks the replay itself.
+
+Every path is expressed in the frame of its own pose at the start of the manoeuvre (the first
+non-zero command), as the paper's Figure 8 starts both paths at one point: ground truth lives in the
+simulator's odom frame, odometry in base_driver's, and each drifts apart before the start (spawn,
+settling) in ways the experiment is not about.
+"""
+
+import bisect
+import math
+from dataclasses import dataclass, field
+from typing import List, Optional, Sequence, Tuple
+
+from thorvald_base.kinematics import DriveState
+
+# The paper's figures for its six-wheeled robot on tarmac (section 3.3.2).
+PAPER_TRUTH_DISTANCE = 80.2  # [m] by RTK-GNSS
+PAPER_ODOMETRY_DISTANCE = 81.0  # [m]
+PAPER_END_POINT_DIFFERENCE = 2.2  # [m]
+PAPER_DURATION = 77.0  # [s]
+PAPER_SEED = 0  # the paper estimator's random pairs, for a reproducible report
+REST = 1.5  # [s] after the last command: base_driver's wheels have ramped down
+SHORT_DRIVE = 0.97  # ground truth below this share of the planned distance: the drive fell behind
+
+
+@dataclass
+class Path:
+    """Poses and body-frame velocities over time (an odometry topic, or a replayed estimator)."""
+
+    t: List[float] = field(default_factory=list)  # [s]
+    x: List[float] = field(default_factory=list)  # [m]
+    y: List[float] = field(default_factory=list)
+    yaw: List[float] = field(default_factory=list)  # [rad]
+    vx: List[float] = field(default_factory=list)  # [m/s] in base_link
+    vy: List[float] = field(default_factory=list)
+    wz: List[float] = field(default_factory=list)  # [rad/s]
+
+    def append(self, t: float, pose: Tuple[float, float, float], twist: Tuple[float, float, float]) -> None:
+        """One sample: pose (x, y, yaw) and twist (vx, vy, wz)."""
+        for name, value in zip(("t", "x", "y", "yaw", "vx", "vy", "wz"), (t, *pose, *twist)):
+            getattr(self, name).append(float(value))
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+
+@dataclass
+class Recording:
+    """One drive as recorded: each list in time order."""
+
+    commands: List[Tuple[float, float, float, float]]  # (t, vx, vy, wz) as sent to the robot
+    truth: Path  # odometry/gazebo
+    odometry: Path  # odometry/base_raw, as base_driver published it
+    states: List[Tuple[float, Tuple[float, ...], Tuple[float, ...]]]  # (t, steering [rad], rim speed [m/s])
+    robot: str = ""
+    source: str = ""  # the bag file
+
+
+@dataclass(frozen=True)
+class Figures:
+    """One path's figures against ground truth."""
+
+    distance: float  # [m]
+    distance_error: float  # [%] of the ground-truth distance (nan for ground truth itself)
+    end_point_difference: float  # [m] from ground truth's end point
+    heading_difference: float  # [rad] at the end, from ground truth's heading
+
+
+@dataclass
+class Report:
+    recording: Recording
+    start: float  # [s] first non-zero command
+    end: float  # [s] REST after the last non-zero command (or the end of the recording)
+    paths: dict  # name -> Path, aligned at the start: "ground truth", "odometry lsq", "odometry paper"
+    figures: dict  # name -> Figures
+    replay_agreement: float  # [m] largest distance between replayed lsq and base_driver's odometry
+    planned_distance: float = math.nan  # [m] of the manoeuvre's plan, when the recording drove it
+    missing_states: int = 0  # base_driver cycles with odometry but no base_state in the recording
+
+
+class ReportError(ValueError):
+    """The recording cannot make a report (missing topics, no manoeuvre in it)."""
+
+
+def manoeuvre_start(commands: Sequence[Tuple[float, float, float, float]]) -> float:
+    for t, vx, vy, wz in commands:
+        if vx or vy or wz:
+            return t
+    raise ReportError("no non-zero velocity command in the recording: nothing was driven")
+
+
+def manoeuvre_end(commands: Sequence[Tuple[float, float, float, float]], rest: float = REST) -> float:
+    """rest [s] after the last non-zero command: the robot has stopped, the recording may go on."""
+    last = max((t for t, vx, vy, wz in commands if vx or vy or wz), default=None)
+    if last is None:
+        raise ReportError("no non-zero velocity command in the recording: nothing was driven")
+    return last + rest
+
+
+def replay(calculator, states: Sequence[Tuple[float, Sequence[float], Sequence[float]]]) -> Path:
+    """base_driver's odometry recomputed from its measured drive states with this calculator."""
+    path = Path()
+    for t, steering, speed in states:
+        odom = calculator.calculate_odometry([DriveState(a, v, 0.0) for a, v in zip(steering, speed)], t)
+        pose, twist = odom.pose, odom.twist
+        path.append(t, (pose.x, pose.y, pose.yaw), (twist.vx, twist.vy, twist.wz))
+    return path
+
+
+def pose_at(path: Path, t: float) -> Tuple[float, float, float]:
+    """The pose of the last sample at or before t (the first one if t is earlier)."""
+    i = max(0, bisect.bisect_right(path.t, t) - 1)
+    return path.x[i], path.y[i], path.yaw[i]
+
+
+def aligned(path: Path, start: float, end: float) -> Path:
+    """The samples in [start, end], as poses in the frame of the pose at start."""
+    x0, y0, yaw0 = pose_at(path, start)
+    c, s = math.cos(yaw0), math.sin(yaw0)
+    out = Path()
+    for i, t in enumerate(path.t):
+        if start <= t <= end:
+            dx, dy = path.x[i] - x0, path.y[i] - y0
+            pose = (c * dx + s * dy, -s * dx + c * dy, math.remainder(path.yaw[i] - yaw0, 2 * math.pi))
+            out.append(t, pose, (path.vx[i], path.vy[i], path.wz[i]))
+    if not out.t or out.t[0] != start:  # the pose at start itself, so every path starts at the origin
+        out.t.insert(0, start)
+        for name in ("x", "y", "yaw"):
+            getattr(out, name).insert(0, 0.0)
+        for name in ("vx", "vy", "wz"):
+            values = getattr(out, name)
+            values.insert(0, values[0] if values else 0.0)
+    return out
+
+
+def path_length(path: Path) -> float:
+    return sum(math.hypot(x1 - x0, y1 - y0) for x0, y0, x1, y1 in zip(path.x, path.y, path.x[1:], path.y[1:]))
+
+
+def figures_of(path: Path, truth: Path) -> Figures:
+    d, dt = path_length(path), path_length(truth)
+    return Figures(
+        d,
+        (d - dt) / dt * 100.0 if path is not truth and dt > 0 else math.nan,
+        math.hypot(path.x[-1] - truth.x[-1], path.y[-1] - truth.y[-1]),
+        math.remainder(path.yaw[-1] - truth.yaw[-1], 2 * math.pi),
+    )
+
+
+def make_report(recording: Recording, calculators: dict) -> Report:
+    """The report of a recording; calculators: estimator name -> a fresh calculator for the robot."""
+    for name, series in (("odometry/gazebo", recording.truth), ("odometry/base_raw", recording.odometry)):
+        if not len(series):
+            raise ReportError(f"no {name} in the recording")
+    if not recording.states:
+        raise ReportError("no base_state in the recording")
+    start = manoeuvre_start(recording.commands)
+    end = min(
+        manoeuvre_end(recording.commands), recording.truth.t[-1], recording.odometry.t[-1], recording.states[-1][0]
+    )
+    if end <= start:
+        raise ReportError(f"the recording ends ({end:.2f} s) before the manoeuvre starts ({start:.2f} s)")
+    truth = aligned(recording.truth, start, end)
+    paths = {"ground truth": truth}
+    replayed = {name: aligned(replay(calc, recording.states), start, end) for name, calc in calculators.items()}
+    # lsq is what base_driver published (what its users see); its replay checks the replay
+    paths["odometry lsq"] = aligned(recording.odometry, start, end)
+    for name, path in replayed.items():
+        paths.setdefault("odometry " + name, path)
+    agreement = _largest_gap(replayed["lsq"], paths["odometry lsq"]) if "lsq" in replayed else math.nan
+    figures = {name: figures_of(path, truth) for name, path in paths.items()}
+    report = Report(recording, start, end, paths, figures, agreement)
+    # a loaded machine may drop messages on the way to rosbag; the replay then differs where they are missing
+    report.missing_states = len(set(recording.odometry.t) - {s[0] for s in recording.states})
+    return report
+
+
+def _largest_gap(a: Path, b: Path) -> float:
+    """Largest distance between a and b at b's sample times."""
+    gap = 0.0
+    for t, x, y in zip(b.t, b.x, b.y):
+        ax, ay, _ = pose_at(a, t)
+        gap = max(gap, math.hypot(ax - x, ay - y))
+    return gap
+
+
+def format_report(report: Report, targets: Optional[Tuple[float, float]] = None) -> str:
+    """The table printed by odometry_report; targets: (distance error [%], end point [m]) for lsq."""
+    rec = report.recording
+    f = report.figures
+    truth = f["ground truth"]
+    names = [n for n in ("ground truth", "odometry lsq", "odometry paper") if n in f]
+    head = f"{'':30}" + "".join(f"{n:>16}" for n in names) + f"{'the paper':>22}"
+    paper_cols = {
+        "distance [m]": f"{PAPER_TRUTH_DISTANCE:.1f} / {PAPER_ODOMETRY_DISTANCE:.1f}",
+        "distance error [%]": f"{(PAPER_ODOMETRY_DISTANCE - PAPER_TRUTH_DISTANCE) / PAPER_TRUTH_DISTANCE * 100:+.1f}",
+        "end-point difference [m]": f"{PAPER_END_POINT_DIFFERENCE:.1f}",
+        "heading at the end [deg]": "-",
+    }
+
+    def row(label, fmt, getter):
+        cells = []
+        for n in names:
+            value = getter(f[n])
+            cells.append(f"{'-' if math.isnan(value) else format(value, fmt):>16}")
+        return f"  {label:28}" + "".join(cells) + f"{paper_cols[label]:>22}"
+
+    lines = [
+        f"Odometry report: {rec.robot or 'robot'}" + (f" ({rec.source})" if rec.source else ""),
+        f"  manoeuvre {report.end - report.start:.1f} s from the first command (the paper: about "
+        f"{PAPER_DURATION:.0f} s); paths aligned at their start pose",
+        head,
+        row("distance [m]", ".2f", lambda g: g.distance),
+        row("distance error [%]", "+.2f", lambda g: g.distance_error),
+        row("end-point difference [m]", ".3f", lambda g: math.nan if g is truth else g.end_point_difference),
+        row(
+            "heading at the end [deg]", "+.2f", lambda g: math.nan if g is truth else math.degrees(g.heading_difference)
+        ),
+        "  (the paper's column: RTK-GNSS / odometry of its six-wheeled robot on tarmac, Figures 8 and 9)",
+    ]
+    if not math.isnan(report.replay_agreement):
+        lines.append(
+            f"  odometry lsq replayed from base_state agrees with base_driver's odometry/base_raw within "
+            f"{report.replay_agreement * 1000:.1f} mm; paper estimator seeded with {PAPER_SEED}"
+        )
+        if report.missing_states:
+            lines[-1] += f" ({report.missing_states} base_state messages missing from the recording)"
+    if not math.isnan(report.planned_distance):
+        lines.append(f"  distance by the manoeuvre's plan {report.planned_distance:.2f} m")
+        if truth.distance < SHORT_DRIVE * report.planned_distance:
+            lines[-1] += (
+                f"; WARNING: ground truth drove only {truth.distance / report.planned_distance:.0%} of it: the "
+                "commands fell behind the simulator, base_driver stopped the wheels at its command timeout "
+                "(a loaded machine: try --real-time-factor 2)"
+            )
+    if targets is not None and "odometry lsq" in f:
+        err, end = targets
+        lsq = f["odometry lsq"]
+        ok = abs(lsq.distance_error) < err and lsq.end_point_difference < end
+        lines.append(
+            f"  targets for lsq: |distance error| < {err:g} %, end point < {end:g} m: {'met' if ok else 'MISSED'}"
+        )
+    return "\n".join(lines)

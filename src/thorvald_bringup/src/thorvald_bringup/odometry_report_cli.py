@@ -1,0 +1,180 @@
+"""``rosrun thorvald_bringup odometry_report``: the paper's odometry experiment, driven and reported.
+
+Without ``--bag`` it drives the robot (default: the paper's Figure 7 robot) through the verification
+manoeuvre in the simulator on the tarmac_gravel world, faster than real time, with base_driver's
+drive states measured from the simulated joints: odometry_report.launch on a ROS master of its
+own, so a running roscore is left alone. rosbag records the drive; then the bag is read and the
+report printed: distance by ground truth and by odometry, the distance error, the end-point
+difference, for both estimators (lsq live from base_driver, paper replayed from the same drive
+states), next to the paper's figures; Figures 8 and 9 are written as PNG.
+
+``--bag FILE`` makes the report from an existing bag (pass ``--robot`` if it is another robot).
+"""
+
+import argparse
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+
+from thorvald_model import ConfigError, load_robot_config
+
+TARGET_DISTANCE_ERROR = 0.5  # [%] for lsq (the paper: 1.0 %)
+TARGET_END_POINT = 1.0  # [m] for lsq (the paper: 2.2 m)
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="odometry_report",
+        description="Drive the paper's odometry verification manoeuvre in the simulator (or read a bag of it) "
+        "and report odometry against ground truth, with Figures 8 and 9 as PNG.",
+    )
+    robot = p.add_mutually_exclusive_group()
+    robot.add_argument(
+        "--robot",
+        default="thorvald_ii_6wd6ws_asym",
+        help="an example robot's name (default: the paper's Figure 7 robot)",
+    )
+    robot.add_argument("--robot-model", metavar="FILE", help="a robot configuration file instead of an example robot")
+    p.add_argument("--bag", metavar="FILE", help="report from this bag instead of driving")
+    p.add_argument("--plan", action="store_true", help="with --bag: the bag is of the verification manoeuvre")
+    p.add_argument("--world", default="tarmac_gravel", help="the simulator's world (default tarmac_gravel)")
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        default="odometry_report",
+        help="where the bag and the figures go (default ./odometry_report)",
+    )
+    p.add_argument("--real-time-factor", type=float, default=0.0, help="0: as fast as the machine can (default)")
+    p.add_argument("--gui", action="store_true", help="open pybullet's window")
+    p.add_argument("--timeout", type=float, default=600.0, help="wall seconds the drive may take (default 600)")
+    return p
+
+
+def robot_file(args) -> str:
+    if args.robot_model:
+        return os.path.abspath(args.robot_model)
+    import rospkg  # noqa: PLC0415
+
+    config_dir = os.path.join(rospkg.RosPack().get_path("thorvald_model"), "config")
+    path = os.path.join(config_dir, args.robot, args.robot + ".yaml")
+    if not os.path.isfile(path):
+        raise LookupError(
+            f"no example robot {args.robot!r}; the examples are: {' '.join(sorted(os.listdir(config_dir)))}"
+        )
+    return path
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def drive(args, model: str, bag: str) -> float:
+    """Runs odometry_report.launch until the drive ends; returns the wall time [s]."""
+    port = free_port()
+    env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
+    log = os.path.join(os.path.dirname(bag), "odometry_report_launch.log")
+    cmd = [
+        "roslaunch",
+        "-p",
+        str(port),
+        "thorvald_bringup",
+        "odometry_report.launch",
+        f"robot_model:={model}",
+        f"world:={args.world}",
+        f"bag:={bag}",
+        f"real_time_factor:={args.real_time_factor:g}",
+        f"with_gui:={'true' if args.gui else 'false'}",
+    ]
+    for stale in (bag, bag + ".active"):
+        if os.path.exists(stale):
+            os.remove(stale)
+    print(
+        f"Driving {os.path.basename(model)[:-5]} through the verification manoeuvre on {args.world} "
+        f"(simulator, measured drives, ROS master on port {port}; log {log})",
+        flush=True,
+    )
+    start = time.time()
+    with open(log, "w") as out:
+        proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, env=env, start_new_session=True)
+        try:
+            proc.wait(timeout=args.timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, 2)  # SIGINT: roslaunch stops its nodes, rosbag closes the bag
+            proc.wait(timeout=60)
+            raise RuntimeError(f"the drive took longer than {args.timeout:g} s of wall time; see {log}") from None
+        except KeyboardInterrupt:
+            os.killpg(proc.pid, 2)
+            proc.wait(timeout=60)
+            raise
+    wall = time.time() - start
+    with open(log) as f:
+        text = f.read()
+    if "Verification drive of" not in text or not os.path.isfile(bag):
+        tail = "\n".join(text.splitlines()[-25:])
+        raise RuntimeError(
+            f"the drive did not finish (no report from verification_drive or no bag); end of {log}:\n{tail}"
+        )
+    return wall
+
+
+def main(argv=None) -> int:
+    args = parser().parse_args(argv)
+    try:
+        model = robot_file(args)
+        config = load_robot_config(model)
+    except (ConfigError, LookupError) as e:
+        print(f"odometry_report: {e}", file=sys.stderr)
+        return 2
+    out = os.path.abspath(args.out)
+    os.makedirs(out, exist_ok=True)
+    name = os.path.splitext(os.path.basename(model))[0]
+    if args.bag:
+        bag = os.path.abspath(args.bag)
+        wall = None
+    else:
+        if shutil.which("roslaunch") is None:
+            print("odometry_report: roslaunch not found: source the workspace's devel/setup.bash", file=sys.stderr)
+            return 2
+        bag = os.path.join(out, "odometry_report.bag")
+        try:
+            wall = drive(args, model, bag)
+        except RuntimeError as e:
+            print(f"odometry_report: {e}", file=sys.stderr)
+            return 1
+    # ROS's Python (rosbag, the calculators' plugin loader) only now: --help and bad robots stay fast
+    from thorvald_base.plugins import load_calculator  # noqa: PLC0415
+    from thorvald_base.verification import commanded_path, plan_for  # noqa: PLC0415
+
+    from .odometry_report import PAPER_SEED, ReportError, format_report, make_report  # noqa: PLC0415
+    from .report_bag import read_recording  # noqa: PLC0415
+    from .report_plots import figure8, figure9  # noqa: PLC0415
+
+    try:
+        recording = read_recording(bag, robot=name)
+        drives = {len(s[1]) for s in recording.states}
+        if drives != {len(config.drives)}:
+            raise ReportError(
+                f"{bag}: base_state has {', '.join(map(str, sorted(drives)))} drives, {name} has {len(config.drives)}: "
+                "pass the bag's robot with --robot or --robot-model"
+            )
+        calculators = {e: load_calculator(config, estimator=e, seed=PAPER_SEED) for e in ("lsq", "paper")}
+        report = make_report(recording, calculators)
+        if wall is not None or args.plan:
+            report.planned_distance = commanded_path(plan_for(config)[1])[1]
+    except ReportError as e:
+        print(f"odometry_report: {e}", file=sys.stderr)
+        return 1
+    print()
+    print(format_report(report, (TARGET_DISTANCE_ERROR, TARGET_END_POINT)))
+    if wall is not None:
+        simulated = recording.states[-1][0] - recording.states[0][0]
+        print(f"  drive: {simulated:.1f} s simulated in {wall:.1f} s wall, world {args.world}")
+    print(f"  bag:      {bag}")
+    print(f"  Figure 8: {figure8(report, os.path.join(out, 'figure8_paths.png'))}")
+    print(f"  Figure 9: {figure9(report, os.path.join(out, 'figure9_velocities.png'))}")
+    return 0

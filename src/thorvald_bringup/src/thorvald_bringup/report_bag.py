@@ -1,0 +1,76 @@
+"""Reads a drive recorded by odometry_report.launch (or any bag with the same topics) into a Recording.
+
+Topics are found by their ending, so a robot in any namespace works: ``.../odometry/gazebo``,
+``.../odometry/base_raw``, ``.../base_state``, and the commands ``.../twist_mux/cmd_vel`` (what
+base_driver got) or else ``.../nav_vel`` (what was sent). Messages are decoded with the definitions
+stored in the bag, so a bag from another machine reads without its message packages.
+"""
+
+import math
+
+import rosbag
+
+from .odometry_report import Path, Recording, ReportError
+
+ENDINGS = {
+    "truth": "odometry/gazebo",
+    "odometry": "odometry/base_raw",
+    "states": "base_state",
+    "commands": "twist_mux/cmd_vel",
+    "sent": "nav_vel",
+}
+
+
+def _yaw(q) -> float:
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def _topics(bag, path):
+    found = {}
+    names = sorted(bag.get_type_and_topic_info().topics)
+    for key, ending in ENDINGS.items():
+        matches = [n for n in names if n.lstrip("/") == ending or n.endswith("/" + ending)]
+        if len(matches) > 1:
+            raise ReportError(f"{path}: several topics end in {ending}: {', '.join(matches)}")
+        if matches:
+            found[key] = matches[0]
+    return found, names
+
+
+def read_recording(path: str, robot: str = "") -> Recording:
+    try:
+        bag = rosbag.Bag(path)
+    except (OSError, rosbag.ROSBagException) as e:
+        raise ReportError(f"{path}: cannot read the bag: {e}") from None
+    with bag:
+        topics, names = _topics(bag, path)
+        missing = [ENDINGS[k] for k in ("truth", "odometry", "states") if k not in topics]
+        if "commands" not in topics and "sent" not in topics:
+            missing.append(f"{ENDINGS['commands']} or {ENDINGS['sent']}")
+        if missing:
+            raise ReportError(f"{path}: no topic ending in {', '.join(missing)} (the bag has: {', '.join(names)})")
+        command_topic = topics.get("commands", topics.get("sent"))
+        rec = Recording([], Path(), Path(), [], robot=robot, source=path)
+        wanted = [topics["truth"], topics["odometry"], topics["states"], command_topic]
+        for topic, msg, stamp in bag.read_messages(topics=wanted):
+            if topic == command_topic:
+                rec.commands.append((stamp.to_sec(), msg.linear.x, msg.linear.y, msg.angular.z))
+            elif topic == topics["states"]:
+                rec.states.append((msg.header.stamp.to_sec(), tuple(msg.steer_pos), tuple(msg.prop_speed)))
+            else:
+                series = rec.truth if topic == topics["truth"] else rec.odometry
+                p, v = msg.pose.pose, msg.twist.twist
+                pose = (p.position.x, p.position.y, _yaw(p.orientation))
+                series.append(msg.header.stamp.to_sec(), pose, (v.linear.x, v.linear.y, v.angular.z))
+    for series in (rec.truth, rec.odometry):
+        _sort(series)
+    rec.commands.sort()
+    rec.states.sort(key=lambda s: s[0])
+    return rec
+
+
+def _sort(series: Path) -> None:
+    order = sorted(range(len(series.t)), key=series.t.__getitem__)
+    for name in ("t", "x", "y", "yaw", "vx", "vy", "wz"):
+        values = getattr(series, name)
+        values[:] = [values[i] for i in order]
