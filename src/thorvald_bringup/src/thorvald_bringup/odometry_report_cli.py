@@ -127,7 +127,10 @@ def main(argv=None) -> int:
     try:
         model = robot_file(args)
         config = load_robot_config(model)
-    except (ConfigError, LookupError) as e:
+    except ConfigError as e:
+        print(e, file=sys.stderr)  # FILE: key path: value: rule, as every command that reads a robot file
+        return 2
+    except LookupError as e:
         print(f"odometry_report: {e}", file=sys.stderr)
         return 2
     out = os.path.abspath(args.out)
