@@ -37,7 +37,6 @@ import sys
 import tempfile
 import threading
 import time
-import warnings
 
 import pybullet as p
 import rospy
@@ -223,9 +222,10 @@ class SimulatorNode:
         self.clock = Every(clock_rate)
         self.odometry = Every(odometry_rate)
         self.drives = Every(drive_state_rate)
-        with warnings.catch_warnings():  # rospy warns of queue_size=None, which is the point here:
-            warnings.simplefilter("ignore")  # /clock goes to every node; written in the loop it costs half
-            self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=None)  # what a writer thread each does
+        # /clock goes to every node, each connection written by a thread of its own with a queue of one
+        # tick (a late reader needs only the latest). Written in the loop (queue_size None) it cost half
+        # as much, but one reader behind a dropped network link then froze the simulation for everyone.
+        self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=1)
         self.tf = tf2_ros.TransformBroadcaster()
         rospy.Service("~pause", Empty, self.srv_pause)
         rospy.Service("~unpause", Empty, self.srv_unpause)
