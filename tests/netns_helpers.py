@@ -56,16 +56,28 @@ class NetnsError(Exception):
 
 
 # ---- the pytest side: the network ---------------------------------------------------------------
-def ip(*args, check=True, timeout=15.0):
-    """Runs `ip ARGS`; NetnsError with the command and its stderr if it fails and check."""
+NETNS_DIR = "/run/netns"  # where `ip netns add` names a namespace
+
+
+def in_namespace(ns, argv):
+    """argv run in network namespace ns. nsenter joins only the network namespace; `ip netns exec`
+    and `ip -n` also make / a slave mount, which fails where / is not a mount point (a chroot, as a
+    freshly bootstrapped Debian), and nothing here needs their remounted /sys."""
+    return ["nsenter", f"--net={NETNS_DIR}/{ns}", *argv]
+
+
+def ip(*args, check=True, timeout=15.0, ns=None):
+    """Runs `ip ARGS` (in network namespace ns, if given); NetnsError with the command and its stderr
+    if it fails and check."""
+    argv = ["ip", *args] if ns is None else in_namespace(ns, ["ip", *args])
     try:
-        out = subprocess.run(["ip", *args], capture_output=True, text=True, timeout=timeout)
+        out = subprocess.run(argv, capture_output=True, text=True, timeout=timeout)
     except FileNotFoundError:
-        raise NetnsError("the `ip` command (Debian package iproute2) is not installed") from None
+        raise NetnsError(f"`{argv[0]}` is not installed (Debian packages iproute2, util-linux)") from None
     except subprocess.TimeoutExpired:
-        raise NetnsError(f"`ip {' '.join(args)}` did not finish within {timeout:.0f} s") from None
+        raise NetnsError(f"`{' '.join(argv)}` did not finish within {timeout:.0f} s") from None
     if check and out.returncode != 0:
-        raise NetnsError(f"`ip {' '.join(args)}` failed (exit {out.returncode}): {out.stderr.strip()}")
+        raise NetnsError(f"`{' '.join(argv)}` failed (exit {out.returncode}): {out.stderr.strip()}")
     return out
 
 
@@ -148,7 +160,7 @@ def namespaces_unavailable():
     probe = f"{PREFIX}{os.getpid()}-probe"
     try:
         ip("netns", "add", probe)
-        ip("-n", probe, "link", "set", "lo", "up")
+        ip("link", "set", "lo", "up", ns=probe)
     except NetnsError as e:
         return str(e)
     finally:
@@ -188,38 +200,38 @@ class Network:
         # no IPv6: no router solicitations, neighbour discovery or MLD (all multicast) on the links
         # (written from inside the namespace: /proc/sys/net is the reading process's namespace's)
         script = "for k in all default; do echo 1 > /proc/sys/net/ipv6/conf/$k/disable_ipv6; done"
-        subprocess.run(["ip", "netns", "exec", ns, "sh", "-c", script], capture_output=True, timeout=15)
-        ip("-n", ns, "link", "set", "lo", "up")
+        subprocess.run(in_namespace(ns, ["sh", "-c", script]), capture_output=True, timeout=15)
+        ip("link", "set", "lo", "up", ns=ns)
 
     def create(self):
         for ns in self.namespaces:
             self._add_namespace(ns)
         sw = self.switch
-        ip("-n", sw, "link", "add", self.bridge, "type", "bridge")
-        ip("-n", sw, "link", "set", self.bridge, "type", "bridge", "mcast_snooping", "0", check=False)
-        ip("-n", sw, "link", "set", self.bridge, "multicast", "off", "up")
+        ip("link", "add", self.bridge, "type", "bridge", ns=sw)
+        ip("link", "set", self.bridge, "type", "bridge", "mcast_snooping", "0", check=False, ns=sw)
+        ip("link", "set", self.bridge, "multicast", "off", "up", ns=sw)
         for h in self.hosts.values():
             ip("link", "add", h.veth, "netns", h.ns, "type", "veth", "peer", "name", h.port, "netns", sw)
-            ip("-n", sw, "link", "set", h.port, "master", self.bridge)
-            ip("-n", sw, "link", "set", h.port, "multicast", "off", "up")
-            ip("-n", h.ns, "addr", "add", f"{h.address}/24", "dev", h.veth)
-            ip("-n", h.ns, "link", "set", h.veth, "multicast", "off", "up")
+            ip("link", "set", h.port, "master", self.bridge, ns=sw)
+            ip("link", "set", h.port, "multicast", "off", "up", ns=sw)
+            ip("addr", "add", f"{h.address}/24", "dev", h.veth, ns=h.ns)
+            ip("link", "set", h.veth, "multicast", "off", "up", ns=h.ns)
 
     def set_link(self, key, up, end="host"):
         """Brings the link of host key down or up at the host's end (its veth) or the switch's (its port)."""
         h = self.hosts[key]
         ns, dev = (h.ns, h.veth) if end == "host" else (self.switch, h.port)
-        ip("-n", ns, "link", "set", dev, "up" if up else "down")
+        ip("link", "set", dev, "up" if up else "down", ns=ns)
 
     def routes(self, key):
-        out = ip("-j", "-n", self.hosts[key].ns, "route", "show", "table", "all")
+        out = ip("-j", "route", "show", "table", "all", ns=self.hosts[key].ns)
         return json.loads(out.stdout or "[]")
 
     def link_stats(self):
         """{(namespace, interface): received multicast packets} for every link of the network."""
         stats = {}
         for ns in self.namespaces:
-            out = ip("-j", "-s", "-n", ns, "link", "show")
+            out = ip("-j", "-s", "link", "show", ns=ns)
             for link in json.loads(out.stdout or "[]"):
                 rx = link.get("stats64", link.get("stats", {})).get("rx", {})
                 stats[(ns, link["ifname"])] = rx.get("multicast", 0)
@@ -271,7 +283,7 @@ class HostProcess:
         self.name, self.ns, self.out_path = name, ns, str(out_path)
         self._out = open(self.out_path, "w")
         self.popen = subprocess.Popen(
-            ["ip", "netns", "exec", ns, *argv],
+            in_namespace(ns, argv),
             env=env,
             stdin=subprocess.PIPE if pipe else subprocess.DEVNULL,
             stdout=subprocess.PIPE if pipe else self._out,

@@ -43,6 +43,7 @@ Needs root (CI has it): where network namespaces cannot be made, the tests fail 
 import ipaddress
 import math
 import os
+import subprocess
 import sys
 import time
 
@@ -601,7 +602,7 @@ def test_traffic_stays_on_the_hosts_subnet(fleet):
             assert net is not None and (net.subnet_of(SUBNET) or net.subnet_of(loopback)), (
                 f"{HOST_NAMES[key]} has a route off the subnet: {route}"
             )
-        sockets = nh.ip("netns", "exec", host.ns, "ss", "-tunaH", check=False)
+        sockets = subprocess.run(nh.in_namespace(host.ns, ["ss", "-tunaH"]), capture_output=True, text=True, timeout=15)
         assert sockets.returncode == 0, sockets.stderr
         peers = []
         for line in sockets.stdout.splitlines():

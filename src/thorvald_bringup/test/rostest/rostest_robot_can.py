@@ -2,10 +2,11 @@
 """robot.launch as on a real robot, over CAN to the device emulator (SLCAN, another process).
 
 base_driver comes up whether or not its adapter's port existed when it first looked (robot.launch
-respawns it, as at a robot's boot); commands on nav_vel go through twist_mux and the bus to the emulated drives, and the measured
-drive states come back: base_state follows, odometry moves forward, base_driver publishes the
-odom -> base_link transform (enable_odom_tf, as on a real robot) and robot_state_publisher the
-robot's links from the model robot.launch loaded. On wall time, as a real robot runs.
+respawns it, as at a robot's boot); commands on nav_vel go through twist_mux and the bus to the
+emulated drives, and the measured drive states come back: base_state follows, odometry moves
+forward, base_driver publishes the odom -> base_link transform (enable_odom_tf, as on a real
+robot) and robot_state_publisher the robot's links from the model robot.launch loaded. On wall
+time, as a real robot runs.
 """
 
 import threading
