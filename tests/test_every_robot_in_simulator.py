@@ -1,5 +1,6 @@
 """Every example robot in the simulator: spawned, driven through a short pattern, and its odometry
-agreeing with ground truth within the bounds README states (docs/every-robot-pattern.md).
+agreeing with ground truth within the bounds README states (its section "Every example robot in
+the simulator").
 
 One launch file in a temporary folder includes thorvald_sim's simulator.launch once (the flat world,
 as fast as the machine can) and robot.launch once per robot in src/thorvald_model/config/ (a new
@@ -49,7 +50,7 @@ class Bounds:
 DIRECTION_FROM = 0.3  # [m]: shorter motions (a spin in place) have no meaningful direction
 # Chosen from 10 runs (3 of them with two busy loops beside, load average up to 21): the worst
 # |odometry - truth| of any robot, and what a wheel 5 % larger or smaller than the robot file says or
-# mirrored steering joints produce (docs/every-robot-pattern.md has the figures).
+# mirrored steering joints produce (README, "Every example robot in the simulator", has the figures).
 BOUNDS = {
     "forward": Bounds(length_rel=0.015, length_abs=0.02, direction=2.0, turn=2.0),
     "turn": Bounds(length_rel=0.05, length_abs=0.05, direction=8.0, turn=4.0),
