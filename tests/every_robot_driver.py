@@ -35,6 +35,7 @@ import rospy
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
+from thorvald_base.conversions import quaternion_yaw
 from thorvald_model import load_robot_config
 from thorvald_model.layout import common_axle
 
@@ -73,13 +74,9 @@ def plan_for(config) -> List[Leg]:
     return legs
 
 
-def yaw_of(q) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
 def planar(odom) -> Tuple[float, float, float]:
     p = odom.pose.pose
-    return p.position.x, p.position.y, yaw_of(p.orientation)
+    return p.position.x, p.position.y, quaternion_yaw(p.orientation)
 
 
 def delta(start: Sequence[float], end: Sequence[float]) -> Tuple[float, float, float]:

@@ -22,7 +22,6 @@ the multicast flag cleared on every link.
 
 import argparse
 import json
-import math
 import os
 import queue
 import re
@@ -39,6 +38,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from tf2_msgs.msg import TFMessage
 
+from thorvald_base.conversions import quaternion_yaw
 from thorvald_msgs.msg import BaseState
 
 PREFIX = "thvnet"  # every namespace of these tests is named PREFIX<pid>-<host>
@@ -475,10 +475,6 @@ def wait_master(uri, param, timeout):
     return False
 
 
-def _yaw(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
 KINDS = {"odom": Odometry, "twist": Twist, "state": BaseState, "tf": TFMessage}  # what an agent records
 
 
@@ -522,7 +518,13 @@ class Agent:
 
     def _on_odom(self, msg, topic):
         p, v = msg.pose.pose, msg.twist.twist
-        record = [rospy.get_time(), msg.header.stamp.to_sec(), p.position.x, p.position.y, _yaw(p.orientation)]
+        record = [
+            rospy.get_time(),
+            msg.header.stamp.to_sec(),
+            p.position.x,
+            p.position.y,
+            quaternion_yaw(p.orientation),
+        ]
         self._add(topic, [*record, v.linear.x, v.linear.y, v.angular.z])
 
     def _on_twist(self, msg, topic):

@@ -14,6 +14,8 @@ import rospy
 import yaml
 from geometry_msgs.msg import Twist
 
+from thorvald_base.conversions import quaternion_yaw
+
 STARTUP_TIMEOUT = 40.0  # [s] for nodes to come up while the machine is busy
 WAIT = 5.0  # [s] default deadline for something that normally takes a few cycles
 STREAM_HZ = 20.0  # [Hz] command stream: well inside base_driver's 0.5 s command timeout
@@ -169,8 +171,7 @@ def speeds_are(msg, speed, tol=TOL):
 
 
 def yaw_of(pose):
-    q = pose.orientation
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    return quaternion_yaw(pose.orientation)
 
 
 def describe(msg):

@@ -6,9 +6,9 @@ base_driver got) or else ``.../nav_vel`` (what was sent). Messages are decoded w
 stored in the bag, so a bag from another machine reads without its message packages.
 """
 
-import math
-
 import rosbag
+
+from thorvald_base.conversions import quaternion_yaw
 
 from .odometry_report import Path, Recording, ReportError
 
@@ -19,10 +19,6 @@ ENDINGS = {
     "commands": "twist_mux/cmd_vel",
     "sent": "nav_vel",
 }
-
-
-def _yaw(q) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 def _topics(bag, path):
@@ -60,7 +56,7 @@ def read_recording(path: str, robot: str = "") -> Recording:
             else:
                 series = rec.truth if topic == topics["truth"] else rec.odometry
                 p, v = msg.pose.pose, msg.twist.twist
-                pose = (p.position.x, p.position.y, _yaw(p.orientation))
+                pose = (p.position.x, p.position.y, quaternion_yaw(p.orientation))
                 series.append(msg.header.stamp.to_sec(), pose, (v.linear.x, v.linear.y, v.angular.z))
     for series in (rec.truth, rec.odometry):
         _sort(series)

@@ -13,18 +13,16 @@ import rospy
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
+from thorvald_base.conversions import quaternion_yaw
+
 STARTUP = 120.0  # [s] wall, for the simulator, the robots' nodes and their spawns on a busy machine
 WALL_LIMIT = 120.0  # [s] wall, for a test's simulated wait
-
-
-def yaw_of(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 def planar(odom):
     """(x, y, yaw) of an Odometry's pose."""
     p = odom.pose.pose
-    return p.position.x, p.position.y, yaw_of(p.orientation)
+    return p.position.x, p.position.y, quaternion_yaw(p.orientation)
 
 
 def delta(start, end):
