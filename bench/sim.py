@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The simulator's speed against raw pybullet, side by side in one run, for 1, 4 and 9 robots.
 
-    python bench/sim.py [--seconds S] [--robots 1 4 9]
+    python bench/sim.py [--seconds S] [--robots 1 4 9] [--clock-rate HZ]
 
 Raw: pybullet alone (no ROS, no Python between steps) loads the standard robot's URDF N times with
 the simulator's settings (merged fixed links, thin tyre contact discs, no joint damping on the
@@ -111,7 +111,7 @@ def core(n: int, seconds: float):
         p.disconnect(c)
 
 
-def node(n: int, seconds: float, port: int):
+def node(n: int, seconds: float, port: int, clock_rate: float):
     """(real-time factor, simulator CPU [s] per simulated second, all nodes' CPU share [cores]).
 
     Every case runs on the one master at port (rospy initialises once per process) with a launch
@@ -130,7 +130,8 @@ def node(n: int, seconds: float, port: int):
     launch = tempfile.NamedTemporaryFile("w", suffix=".launch", delete=False)
     launch.write(
         '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'
-        '<arg name="real_time_factor" value="0"/><arg name="output" value="log"/></include>\n'
+        '<arg name="real_time_factor" value="0"/><arg name="output" value="log"/>'
+        f'<arg name="clock_rate" value="{clock_rate:g}"/></include>\n'
         f"{robots}\n</launch>\n"
     )
     launch.close()
@@ -206,6 +207,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated seconds measured per case")
     parser.add_argument("--robots", type=int, nargs="+", default=[1, 4, 9])
+    parser.add_argument("--clock-rate", type=float, default=100.0, help="the simulator's ~clock_rate [Hz] (100)")
     args = parser.parse_args()
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # the master and launches are stopped on the way out
     print(
@@ -221,7 +223,7 @@ def main() -> int:
         for n in args.robots:
             raw_rtf, raw_cpu = raw(n, args.seconds)
             core_cpu = core(n, args.seconds)
-            node_rtf, node_cpu, all_cpu = node(n, args.seconds, port)
+            node_rtf, node_cpu, all_cpu = node(n, args.seconds, port, args.clock_rate)
             results[n] = (raw_rtf, node_rtf, raw_cpu, node_cpu)
             print(
                 f"{n:>6} {raw_rtf:>7.1f}x {node_rtf:>8.1f}x {raw_cpu:>9.3f}s {core_cpu:>10.3f}s {node_cpu:>10.3f}s"

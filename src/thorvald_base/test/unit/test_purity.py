@@ -24,6 +24,7 @@ NOT_PURE = {
     "thorvald_teleop.teleop_node": "a node",
     "thorvald_teleop.keyboard_node": "a node",
     "thorvald_base.conversions": "the one module that builds messages",
+    "thorvald_base.publishing": "a rospy publisher for fast streams",
     "thorvald_base.msg": "aliases of thorvald_msgs for code written for the original",
     "thorvald_base.srv": "aliases of thorvald_msgs for code written for the original",
     "thorvald_bringup.report_bag": "reads a rosbag, whose messages are genpy's",

@@ -40,13 +40,14 @@ import time
 
 import pybullet as p
 import rospy
-import tf2_ros
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty, EmptyResponse
+from tf2_msgs.msg import TFMessage
 
 from thorvald_base import conversions
+from thorvald_base.publishing import NonBlockingPublisher
 from thorvald_model import ConfigError
 from thorvald_msgs.msg import BaseState
 from thorvald_msgs.srv import (
@@ -106,9 +107,9 @@ class RobotIO:
         ns = namespace.rstrip("/") + "/" if namespace else "/"
         self.namespace = ns
         self.publish_tf = publish_tf
-        self.odom_pub = rospy.Publisher(ns + d.odometry_topic, Odometry, queue_size=10)
-        self.joint_pub = rospy.Publisher(ns + "joint_states", JointState, queue_size=10)
-        self.drive_pub = rospy.Publisher(ns + "drive_states", BaseState, queue_size=10)
+        self.odom_pub = NonBlockingPublisher(ns + d.odometry_topic, Odometry)
+        self.joint_pub = NonBlockingPublisher(ns + "joint_states", JointState)
+        self.drive_pub = NonBlockingPublisher(ns + "drive_states", BaseState)
         self.lock = threading.Lock()
         self.command = None  # the latest (steering, speeds, max steering speeds), to apply in the loop
         self.command_time = None  # [s] simulated time it arrived
@@ -188,7 +189,7 @@ class RobotIO:
         )
         self.odom_pub.publish(msg)
         if self.publish_tf:
-            tf.sendTransform(conversions.odometry_transform(msg))
+            tf.publish(TFMessage([conversions.odometry_transform(msg)]))
 
     def publish_drives(self, stamp):
         if self.drive_pub.get_num_connections():  # base_driver with measured drives
@@ -222,11 +223,10 @@ class SimulatorNode:
         self.clock = Every(clock_rate)
         self.odometry = Every(odometry_rate)
         self.drives = Every(drive_state_rate)
-        # /clock goes to every node, each connection written by a thread of its own with a queue of one
-        # tick (a late reader needs only the latest). Written in the loop (queue_size None) it cost half
-        # as much, but one reader behind a dropped network link then froze the simulation for everyone.
-        self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=1)
-        self.tf = tf2_ros.TransformBroadcaster()
+        # Written in the loop on non-blocking sockets (thorvald_base.publishing): a writer thread per reader
+        # cost more than the physics; a blocking write froze the simulation when one reader's link dropped.
+        self.clock_pub = NonBlockingPublisher("/clock", Clock)
+        self.tf = NonBlockingPublisher("/tf", TFMessage)
         rospy.Service("~pause", Empty, self.srv_pause)
         rospy.Service("~unpause", Empty, self.srv_unpause)
         rospy.Service("~reset", Empty, self.srv_reset)
