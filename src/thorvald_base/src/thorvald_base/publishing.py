@@ -52,18 +52,26 @@ class _NonBlockingWriter:
         self.topic = topic
         self.rest = b""  # what the socket has not taken yet of a message it took part of
         self.missed = 0  # messages this reader missed
-        connection.socket.setblocking(False)
+        # Made non-blocking at the first write, where a failure removes the reader: not here, in publish().
+        # Another rospy thread may be closing the connection meanwhile (a new reader's arrival closes the
+        # dead ones, _TopicImpl.add_connection), and TCPROSTransport.close closes the socket before it
+        # forgets it: raised from here, that closed socket killed the simulator when spawn_robot nodes left.
+        self.nonblocking = False
 
     def __call__(self, data) -> bool:
         c = self.connection
-        if c.done or c.socket is None:
+        sock = c.socket  # once: another thread's close() sets it to None
+        if c.done or sock is None:
             raise TransportTerminated("connection closed")
         try:
+            if not self.nonblocking:
+                sock.setblocking(False)
+                self.nonblocking = True
             if self.rest:
-                self.rest = self.rest[c.socket.send(self.rest) :]
+                self.rest = self.rest[sock.send(self.rest) :]
                 if self.rest:
                     raise BlockingIOError
-            sent = c.socket.send(data)
+            sent = sock.send(data)
         except BlockingIOError:
             self.missed += 1
             rospy.logwarn_throttle(

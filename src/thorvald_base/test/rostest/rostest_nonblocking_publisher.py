@@ -8,7 +8,9 @@ then reads nothing. About 10 MB go out, more than the kernel buffers between pub
 reader hold. The publisher must not block; the rospy subscriber gets every message; the stalled
 reader, once it reads, finds whole messages only (a message the socket took part of is finished
 with the next publish, before anything else), in order, some missed, and then the new ones; a
-reader that goes away is removed.
+reader that goes away is removed. A reader whose socket another rospy thread has just closed (rospy
+closes dead connections when a new reader arrives, and closes the socket before it forgets it) is
+removed too, whether it was written to before or is new: publish() does not raise.
 """
 
 import io
@@ -44,14 +46,14 @@ def index(data: str) -> int:
 class StalledReader:
     """A TCPROS subscriber of the test's own: the handshake, then frames only when asked to read."""
 
-    def __init__(self, topic: str):
-        code, msg, protocol = ServerProxy(rospy.get_node_uri()).requestTopic("/stalled_reader", topic, [["TCPROS"]])
+    def __init__(self, topic: str, callerid: str = "/stalled_reader"):
+        code, msg, protocol = ServerProxy(rospy.get_node_uri()).requestTopic(callerid, topic, [["TCPROS"]])
         assert code == 1, msg
         _, host, port = protocol
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, STALLED_RCVBUF)
         self.sock.connect((host, port))
-        header = {"callerid": "/stalled_reader", "topic": topic, "type": String._type, "md5sum": String._md5sum}
+        header = {"callerid": callerid, "topic": topic, "type": String._type, "md5sum": String._md5sum}
         self.sock.sendall(encode_ros_handshake_header(header))
         (length,) = struct.unpack("<I", self.exact(4))
         reply = self.exact(length)
@@ -134,6 +136,35 @@ class TestNonBlockingPublisher(unittest.TestCase):
         self.wait_for(received, i)
         self.assertEqual(received, list(range(i)))
         sub.unregister()
+
+    def test_socket_closed_by_another_thread(self):
+        topic = "/closing"
+        received = []
+        pub = NonBlockingPublisher(topic, String)
+        sub = rospy.Subscriber(topic, String, lambda m: received.append(int(m.data)))
+        old = StalledReader(topic, "/old_reader")  # written to before its socket is closed
+        self.wait_connections(pub, 2)
+        pub.publish(String("0"))
+        new = StalledReader(topic, "/new_reader")  # its socket closed before its first message
+        self.wait_connections(pub, 3)
+        closing = [c for c in pub.impl.connections if c.endpoint_id in ("/old_reader", "/new_reader")]
+        self.assertEqual(len(closing), 2)
+        for c in closing:  # the first half of TCPROSTransport.close, as another thread runs it
+            c.socket.close()
+        for i in range(1, 4):
+            pub.publish(String(str(i)))  # raised OSError (EBADF) for the new reader: the simulator died of it
+        self.assertEqual(pub.get_num_connections(), 1, "the closed readers were not removed")
+        self.wait_for(received, 4)
+        self.assertEqual(received, [0, 1, 2, 3])
+        for reader in (old, new):
+            reader.sock.close()
+        sub.unregister()
+
+    def wait_connections(self, pub, n):
+        deadline = time.monotonic() + 20
+        while pub.get_num_connections() < n and time.monotonic() < deadline:
+            time.sleep(0.05)
+        self.assertEqual(pub.get_num_connections(), n)
 
     def wait_for(self, received, n):
         deadline = time.monotonic() + 20
