@@ -3,10 +3,11 @@
 
     python bench/sim.py [--seconds S] [--robots 1 4 9] [--clock-rate HZ]
 
-Raw: pybullet alone (no ROS, no Python between steps) loads the standard robot's URDF N times with
-the simulator's settings (merged fixed links, thin tyre contact discs, no joint damping on the
-motors), sets its wheels to 0.5 m/s once and steps at 240 Hz. Core: the simulator's own
-Simulation class (ramps, springs, Python between steps) stepping the same robots, no ROS. Node:
+Raw: pybullet alone (no ROS, no Python between steps) steps at 240 Hz the very world the simulator
+builds: the flat world and N standard robots set up by the simulator's Simulation class (merged
+fixed links, thin tyre contact discs, torque-limited motors, no drag), commanded 0.5 m/s once.
+Core: Simulation.step on the same world (the wheels' ramps and the springs in Python between
+steps), no ROS. Node:
 the simulator node on the benchmark's master, N robots through robot.launch (base_driver,
 twist_mux, robot_state_publisher each), driven at 0.5 m/s through twist_mux, the simulator as fast
 as it can (real_time_factor 0; it waits for robots whose commands lag, ~max_lag).
@@ -38,54 +39,13 @@ def grid(k):
     return SPACING * (k % 3), SPACING * (k // 3)
 
 
-def raw(n: int, seconds: float):
-    """(real-time factor, CPU [s] per simulated second) of pybullet stepping n robots."""
-    import pybullet as p  # noqa: PLC0415
+def world(n: int):
+    """A pybullet client with the flat world and n standard robots commanded 0.5 m/s, under way.
 
-    from thorvald_model.description import generate_urdf  # noqa: PLC0415
-    from thorvald_sim import robot as simrobot  # noqa: PLC0415
-    from thorvald_sim.description import parse_description, with_tyre_contact  # noqa: PLC0415
-    from thorvald_sim.simulation import SOLVER_ITERATIONS  # noqa: PLC0415
-
-    urdf = generate_urdf(STD)
-    d = parse_description(urdf)
-    urdf = with_tyre_contact(urdf, [x.wheel_joint for x in d.drives], simrobot.TYRE_CONTACT_WIDTH)
-    with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
-        f.write(urdf)
-    c = p.connect(p.DIRECT)
-    try:
-        p.setPhysicsEngineParameter(fixedTimeStep=1 / 240, numSolverIterations=SOLVER_ITERATIONS, physicsClientId=c)
-        p.setGravity(0, 0, -9.81, physicsClientId=c)
-        plane = p.createMultiBody(0, p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c), physicsClientId=c)
-        p.changeDynamics(plane, -1, lateralFriction=0.9, physicsClientId=c)
-        for k in range(n):
-            x, y = grid(k)
-            with simrobot._quiet_stdout():
-                body = p.loadURDF(f.name, (x, y, 0.0), flags=simrobot.LOAD_FLAGS, physicsClientId=c)
-            for j in range(p.getNumJoints(body, physicsClientId=c)):
-                name = p.getJointInfo(body, j, physicsClientId=c)[1].decode()
-                p.changeDynamics(body, j, jointDamping=0.0, lateralFriction=1.0, physicsClientId=c)
-                if name.startswith("wheel"):
-                    p.setJointMotorControl2(
-                        body, j, p.VELOCITY_CONTROL, targetVelocity=2.5, force=67.2, physicsClientId=c
-                    )
-                else:
-                    p.setJointMotorControl2(
-                        body, j, p.POSITION_CONTROL, targetPosition=0.0, force=42.9, physicsClientId=c
-                    )
-        steps = round(seconds * 240)
-        wall, cpu = time.perf_counter(), time.process_time()
-        for _ in range(steps):
-            p.stepSimulation(physicsClientId=c)
-        wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-    finally:
-        p.disconnect(c)
-        os.unlink(f.name)
-    return seconds / wall, cpu / seconds
-
-
-def core(n: int, seconds: float):
-    """CPU [s] per simulated second of the simulator's Simulation class stepping n commanded robots, no ROS."""
+    Set up by the simulator's own Simulation class, so raw and core step the very bodies, motors,
+    frictions and damping the node steps (an earlier hand-made copy of those settings kept
+    pybullet's default drag of 0.04 /s, which the simulator removes, and stepped 18 % cheaper).
+    """
     import pybullet as p  # noqa: PLC0415
 
     from thorvald_model.description import generate_urdf  # noqa: PLC0415
@@ -95,13 +55,37 @@ def core(n: int, seconds: float):
 
     urdf = generate_urdf(STD)
     c = p.connect(p.DIRECT)
+    sim = Simulation(c, load_world(resolve_world("flat")))
+    for k in range(n):
+        x, y = grid(k)
+        sim.spawn(f"r{k}", urdf, Pose2D(x, y, 0.0)).command([0.0] * 4, [0.5] * 4)
+    for _ in range(240):  # under way
+        sim.step()
+    return c, sim
+
+
+def raw(n: int, seconds: float):
+    """(real-time factor, CPU [s] per simulated second) of bare pybullet.stepSimulation, n robots."""
+    import pybullet as p  # noqa: PLC0415
+
+    c, _ = world(n)
     try:
-        sim = Simulation(c, load_world(resolve_world("flat")))
-        for k in range(n):
-            x, y = grid(k)
-            sim.spawn(f"r{k}", urdf, Pose2D(x, y, 0.0)).command([0.0] * 4, [0.5] * 4)
-        for _ in range(240):  # under way
-            sim.step()
+        steps = round(seconds * 240)
+        wall, cpu = time.perf_counter(), time.process_time()
+        for _ in range(steps):
+            p.stepSimulation(physicsClientId=c)
+        wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    finally:
+        p.disconnect(c)
+    return seconds / wall, cpu / seconds
+
+
+def core(n: int, seconds: float):
+    """CPU [s] per simulated second of the simulator's Simulation.step (ramps, springs: Python) for n robots."""
+    import pybullet as p  # noqa: PLC0415
+
+    c, sim = world(n)
+    try:
         steps = round(seconds * 240)
         cpu = time.process_time()
         for _ in range(steps):
@@ -139,13 +123,23 @@ def node(n: int, seconds: float, port: int, clock_rate: float):
     sub = rospy.Subscriber("/clock", Clock, lambda m: clock.__setitem__("t", m.clock.to_sec()))
     pubs = [rospy.Publisher(f"/r{k}/nav_vel", Twist, queue_size=1) for k in range(n)]
     stop = threading.Event()
+    measured = False
+    output = tempfile.NamedTemporaryFile("w", prefix=f"bench_sim_{n}_robots_", suffix=".log", delete=False)
     proc = subprocess.Popen(
         ["roslaunch", launch.name],
         env=env,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
+        stdout=output,
+        stderr=subprocess.STDOUT,
         start_new_session=True,
     )
+
+    def check():
+        """Raises if the launch stopped (a required node, the simulator, died), with the end of its output."""
+        if proc.poll() is not None:
+            with open(output.name, errors="replace") as f:
+                tail = f.read()[-3000:]
+            raise RuntimeError(f"{n} robots: the launch stopped (exit {proc.returncode}); {output.name} ends:\n{tail}")
+
     try:
         twist = Twist()
         twist.linear.x = 0.5
@@ -159,6 +153,7 @@ def node(n: int, seconds: float, port: int, clock_rate: float):
         threading.Thread(target=drive, daemon=True).start()
         deadline = time.time() + 120 + 15 * n
         while time.time() < deadline and (clock["t"] is None or sum(p.get_num_connections() for p in pubs) < n):
+            check()
             time.sleep(0.2)
         if clock["t"] is None:
             raise RuntimeError(f"{n} robots: the simulator never published /clock")
@@ -168,12 +163,16 @@ def node(n: int, seconds: float, port: int, clock_rate: float):
         t0, w0 = clock["t"], time.perf_counter()
         c0 = sum(cpu_seconds(p, missing=0.0) for p in simulator)
         a0 = sum(cpu_seconds(p, missing=0.0) for p in every)
-        while clock["t"] - t0 < seconds and time.perf_counter() - w0 < 20 * seconds:
+        while clock["t"] - t0 < seconds and time.perf_counter() - w0 < 20 * seconds and proc.poll() is None:
             time.sleep(0.1)
+        check()
         t1, w1 = clock["t"], time.perf_counter()
+        if t1 <= t0:
+            raise RuntimeError(f"{n} robots: /clock stood still for {w1 - w0:.0f} s; see {output.name}")
         c1 = sum(cpu_seconds(p, missing=0.0) for p in simulator)
         a1 = sum(cpu_seconds(p, missing=0.0) for p in every)
         simulated = t1 - t0
+        measured = True
         return simulated / (w1 - w0), (c1 - c0) / simulated, (a1 - a0) / (w1 - w0)
     finally:
         stop.set()
@@ -188,6 +187,9 @@ def node(n: int, seconds: float, port: int, clock_rate: float):
                 os.kill(pid, signal.SIGKILL)
             proc.kill()
         os.unlink(launch.name)
+        output.close()
+        if measured:
+            os.unlink(output.name)  # kept when the case failed
 
 
 def children(pid):

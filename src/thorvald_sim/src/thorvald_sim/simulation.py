@@ -15,7 +15,7 @@ from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
 from .scene import build_scene
 from .world import WorldConfig
 
-SOLVER_ITERATIONS = 50  # pybullet's default, named so the benchmark's raw stepping uses the same
+SOLVER_ITERATIONS = 50  # pybullet's default, set explicitly
 
 
 class SpawnError(Exception):
