@@ -9,16 +9,21 @@ simulated clock: it publishes ``/clock`` ``~speedup`` times faster than real tim
 Parameters: ``~robot_model`` (the robot's YAML, for the plan and the report), ``~own_clock``
 (default true), ``~speedup`` (default 5), ``~clock_step`` [s] of simulated time per /clock message
 (default 0.005), ``~command_rate`` [Hz] (default 20), ``~startup_timeout`` [s] of wall time
-(default 30), ``~command_subscribers`` (default 1: twist_mux; 2 when ``rosbag record`` must hear
-the commands from the first one), ``~ready_topic`` (an Odometry topic that must publish before the
-drive starts, e.g. ``odometry/gazebo``: the robot is in the simulator; default none), ``~settle``
-[s] of simulated time standing still before and after the manoeuvre (default 1).
+(default 30), ``~command_subscribers`` (default 1: twist_mux), ``~ready_topic`` (an Odometry
+topic that must publish before the drive starts, e.g. ``odometry/gazebo``: the robot is in the
+simulator; default none), ``~settle`` [s] of simulated time standing still before and after the
+manoeuvre (default 1), ``~recorder`` and ``~recorded_topics`` (a ``rosbag record`` node and the
+topics it records, a list or a space-separated string: the drive starts only when every
+publisher of each of them has a connection to the recorder, as ``rosnode info`` shows; default
+none).
 """
 
 import os
 import sys
 import time
+import xmlrpc.client
 
+import rosgraph
 import rospy
 from geometry_msgs.msg import Twist as TwistMsg
 from nav_msgs.msg import Odometry
@@ -27,6 +32,8 @@ from rosgraph_msgs.msg import Clock
 from thorvald_model import ConfigError, load_robot_config
 
 from .verification import duration, plan_for, report, twist_at
+
+RECORDER_POLL = 0.2  # [s] wall between questions to the publishers of the recorded topics
 
 
 class VerificationDrive:
@@ -41,6 +48,12 @@ class VerificationDrive:
         self.own_clock = bool(rospy.get_param("~own_clock", True))
         self.command_subscribers = int(rospy.get_param("~command_subscribers", 1))
         self.settle = float(rospy.get_param("~settle", 1.0))
+        recorder = str(rospy.get_param("~recorder", ""))
+        self.recorder = rospy.resolve_name(recorder) if recorder else ""
+        topics = rospy.get_param("~recorded_topics", [])
+        self.recorded = [rospy.resolve_name(t) for t in (topics.split() if isinstance(topics, str) else topics)]
+        self.unrecorded = list(self.recorded) if self.recorder else []
+        self.recorder_checked = 0.0  # [s] wall
         ready_topic = str(rospy.get_param("~ready_topic", ""))
         self.ready = not ready_topic
         if ready_topic:
@@ -62,6 +75,15 @@ class VerificationDrive:
 
     def on_ready(self, _msg):
         self.ready = True
+
+    def recording_all(self) -> bool:
+        """Whether the recorder has a connection from every publisher of every recorded topic (asked
+        at most every RECORDER_POLL s of wall time: one XML-RPC call per publisher)."""
+        if not self.unrecorded or time.time() - self.recorder_checked < RECORDER_POLL:
+            return not self.unrecorded
+        self.recorder_checked = time.time()
+        self.unrecorded = [t for t in self.unrecorded if not connected_to(self.recorder, t)]
+        return not self.unrecorded
 
     def tick(self):
         if self.own_clock:
@@ -88,15 +110,21 @@ class VerificationDrive:
                     raise RuntimeError("no /clock: the simulator did not come up")
                 time.sleep(0.01)
             self.sim_time = rospy.get_time()
-        while not (self.ready and self.odom_seen and self.cmd_pub.get_num_connections() >= self.command_subscribers):
+        while not (
+            self.ready
+            and self.odom_seen
+            and self.cmd_pub.get_num_connections() >= self.command_subscribers
+            and self.recording_all()
+        ):
             if time.time() > deadline or rospy.is_shutdown():
                 raise RuntimeError(
                     "the robot did not come up: odometry/base_raw {}, ready topic {}, {} of {} subscribers of the "
-                    "commands".format(
+                    "commands{}".format(
                         "heard" if self.odom_seen else "silent",
                         "heard" if self.ready else "silent",
                         self.cmd_pub.get_num_connections(),
                         self.command_subscribers,
+                        f", {self.recorder} not connected to {' '.join(self.unrecorded)}" if self.unrecorded else "",
                     )
                 )
             self.tick()
@@ -128,6 +156,23 @@ class VerificationDrive:
             sim_time=total,
             wall=time.time() - start_wall,
         )
+
+
+def connected_to(subscriber: str, topic: str) -> bool:
+    """Whether topic has publishers and each has a connection to the node subscriber (their bus info)."""
+    master = rosgraph.Master(rospy.get_name())
+    try:
+        publishers = dict(master.getSystemState()[0]).get(topic, [])
+        if not publishers:
+            return False
+        for node in publishers:
+            info = xmlrpc.client.ServerProxy(master.lookupNode(node)).getBusInfo(rospy.get_name())[2]
+            # rows: (connection id, the other end's node, direction, transport, topic, connected, ...)
+            if not any(row[1] == subscriber and row[2] == "o" and row[4] == topic for row in info):
+                return False
+    except (OSError, xmlrpc.client.Error, rosgraph.MasterError):
+        return False  # a node that is starting or leaving: asked again
+    return True
 
 
 def main():

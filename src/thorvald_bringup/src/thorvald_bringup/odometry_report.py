@@ -161,6 +161,16 @@ def make_report(recording: Recording, calculators: dict) -> Report:
     if not recording.states:
         raise ReportError("no base_state in the recording")
     start = manoeuvre_start(recording.commands)
+    for name, first in (
+        ("odometry/gazebo", recording.truth.t[0]),
+        ("odometry/base_raw", recording.odometry.t[0]),
+        ("base_state", recording.states[0][0]),
+    ):
+        if first > start:  # its pose at the start is unknown: aligning at its first sample would cut the path
+            raise ReportError(
+                f"{name} was recorded from {first:.2f} s only, {first - start:.2f} s after the manoeuvre started "
+                f"({start:.2f} s): the recorder connected to it late"
+            )
     end = min(
         manoeuvre_end(recording.commands), recording.truth.t[-1], recording.odometry.t[-1], recording.states[-1][0]
     )

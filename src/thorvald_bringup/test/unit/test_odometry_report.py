@@ -105,6 +105,21 @@ def test_a_recording_without_motion_or_topics_is_refused_with_the_reason(asym):
         make_report(late, calculators(asym))
 
 
+def test_a_topic_recorded_only_after_the_manoeuvre_started_is_refused(asym):
+    # rosbag connected to ground truth 0.6 s into the drive: aligned at its first sample, ground truth
+    # would lack its first metres (a CI run reported +1.05 % for that)
+    rec = synthetic(asym, [(Twist(1.0, 0.0, 0.0), 4.0)])
+    start = next(t for t, vx, vy, wz in rec.commands if vx)
+    assert make_report(rec, calculators(asym, ("lsq",)))  # recorded from before the start: fine
+    cut = next(i for i, t in enumerate(rec.truth.t) if t >= start + 0.6)
+    truth = Path(*(getattr(rec.truth, name)[cut:] for name in ("t", "x", "y", "yaw", "vx", "vy", "wz")))
+    with pytest.raises(ReportError, match=r"odometry/gazebo was recorded from .* 0\.6\d s after the manoeuvre started"):
+        make_report(Recording(rec.commands, truth, rec.odometry, rec.states), calculators(asym, ("lsq",)))
+    states = [s for s in rec.states if s[0] > start]
+    with pytest.raises(ReportError, match="base_state was recorded from"):
+        make_report(Recording(rec.commands, rec.truth, rec.odometry, states), calculators(asym, ("lsq",)))
+
+
 def test_the_table_puts_both_estimators_beside_the_papers_figures_and_judges_the_targets(asym):
     report = make_report(synthetic(asym, [(Twist(1.0, 0.0, 0.0), 10.0)], wheel_scale=1.01), calculators(asym))
     text = format_report(report, (0.5, 1.0))
