@@ -4,8 +4,9 @@ The pybullet client is passed in (``pybullet.connect(pybullet.DIRECT)`` or ``GUI
 never connects. Time is the simulated time [s], advanced by one physics step of 1 / physics_rate.
 """
 
+import time
 from dataclasses import dataclass
-from typing import Dict, Tuple
+from typing import Dict, Optional, Tuple
 
 import numpy as np
 import pybullet as p
@@ -55,6 +56,7 @@ class Simulation:
         self.robots: Dict[str, SimRobot] = {}
         self.time = 0.0  # [s] simulated
         self.steps = 0
+        self.solver_cpu = 0.0  # [s] of this thread's CPU time spent in pybullet's stepSimulation, all steps
 
     def spawn(self, name: str, urdf: str, pose: Pose2D) -> SimRobot:
         """Loads a robot; SpawnError (the world unchanged) if the name is taken or the URDF unusable."""
@@ -81,7 +83,10 @@ class Simulation:
         """One physics step of dt: the wheels' ramps and the suspensions' springs, then the solver."""
         for robot in self.robots.values():
             robot.before_step(self.dt)
+        # the thread's CPU clock (0.2 us a read): what the solver costs here, beside whatever else runs
+        start = time.thread_time()
         p.stepSimulation(physicsClientId=self.client)
+        self.solver_cpu += time.thread_time() - start
         self.steps += 1
         self.time = self.steps * self.dt
 
@@ -114,3 +119,45 @@ def save_png(image, path: str) -> None:
     from PIL import Image  # noqa: PLC0415  (only when a snapshot is taken)
 
     Image.fromarray(image, "RGB").save(path)
+
+
+@dataclass(frozen=True)
+class Performance:
+    """How the simulation ran over a window of wall time."""
+
+    wall: float  # [s] the window's length
+    simulated: float  # [s] simulated time that passed in it
+    cpu: float  # [s] the simulator process's CPU time in it (every thread)
+    solver_cpu: float  # [s] of that spent in pybullet's solver
+
+    @property
+    def real_time_factor(self) -> float:
+        return self.simulated / self.wall if self.wall > 0 else 0.0
+
+    def per_simulated_second(self, seconds: float) -> float:
+        """A CPU time [s] of the window per simulated second (0 when time stood still)."""
+        return seconds / self.simulated if self.simulated > 0 else 0.0
+
+
+class PerformanceMeter:
+    """Cuts the simulator's run into windows of at least period [s] of wall time and measures each."""
+
+    def __init__(self, period: float = 1.0):
+        self.period = period
+        self._start = None  # (wall, simulated, cpu, solver cpu) at the window's start
+
+    @property
+    def last_wall(self) -> float:
+        """[s] wall time the current window started (-inf before the first sample)."""
+        return self._start[0] if self._start else float("-inf")
+
+    def sample(self, wall: float, simulated: float, cpu: float, solver_cpu: float) -> Optional[Performance]:
+        """The Performance of the window that ends here, or None while it is shorter than period."""
+        now = (wall, simulated, cpu, solver_cpu)
+        if self._start is None:
+            self._start = now
+            return None
+        if wall - self._start[0] < self.period:
+            return None
+        start, self._start = self._start, now
+        return Performance(*(b - a for a, b in zip(start, now)))

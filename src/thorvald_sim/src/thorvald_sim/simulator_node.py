@@ -18,6 +18,8 @@ Private parameters:
 ``~publish_tf``           default for robots: tf odom -> base_link from ground truth (false)
 ``~tyre_contact_width``   width of the wheels' collision discs [m] (0.01; see robot.py)
 ``~paused``               start paused (false)
+``~diagnostics_rate``     /diagnostics per wall second [Hz] (1; 0: none): the real-time factor
+                          reached and the CPU the simulation costs (see ``publish_performance``)
 ========================  ================================================================
 
 Per robot, in its namespace: subscribes the command topic (``base_state``, as the original plugin,
@@ -28,7 +30,7 @@ suspension) and ``drive_states`` (thorvald_msgs/BaseState: what each drive's enc
 
 Services: ``~pause``, ``~unpause``, ``~reset`` (std_srvs/Empty, as Gazebo's), ``~spawn_robot``,
 ``~delete_robot``, ``~snapshot`` (thorvald_msgs). The node publishes ``/clock``, so everything with
-``/use_sim_time`` runs on simulated time; its own pacing is on the wall clock.
+``/use_sim_time`` runs on simulated time (its own pacing is on the wall clock), and ``/diagnostics``.
 """
 
 import math
@@ -40,6 +42,7 @@ import time
 
 import pybullet as p
 import rospy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -60,7 +63,7 @@ from thorvald_msgs.srv import (
 )
 
 from .robot import Pose2D
-from .simulation import Camera, Simulation, SpawnError, save_png
+from .simulation import Camera, PerformanceMeter, Simulation, SpawnError, save_png
 from .world import load_world, resolve_world
 
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
@@ -216,6 +219,7 @@ class SimulatorNode:
         self.default_tf = bool(rospy.get_param("~publish_tf", False))
         tyre = positive("tyre_contact_width", 0.01)
         self.paused = bool(rospy.get_param("~paused", False))
+        diagnostics_rate = positive("diagnostics_rate", 1.0, allow_zero=True)
         self.client = p.connect(p.GUI if self.gui else p.DIRECT)
         self.sim = Simulation(self.client, world, physics_rate, tyre)
         self.lock = threading.RLock()
@@ -227,6 +231,9 @@ class SimulatorNode:
         # cost more than the physics; a blocking write froze the simulation when one reader's link dropped.
         self.clock_pub = NonBlockingPublisher("/clock", Clock)
         self.tf = NonBlockingPublisher("/tf", TFMessage)
+        self.diagnostics = NonBlockingPublisher("/diagnostics", DiagnosticArray)
+        self.meter = PerformanceMeter(1.0 / diagnostics_rate if diagnostics_rate else float("inf"))
+        self.diagnostics_rate = diagnostics_rate
         rospy.Service("~pause", Empty, self.srv_pause)
         rospy.Service("~unpause", Empty, self.srv_unpause)
         rospy.Service("~reset", Empty, self.srv_reset)
@@ -323,6 +330,8 @@ class SimulatorNode:
                         io.apply(now, self.command_timeout)
                     self.sim.step()
                     self.publish(self.sim.time)
+            if self.diagnostics_rate:
+                self.publish_performance(time.monotonic())
             if paused:
                 anchor = None
                 time.sleep(0.01)
@@ -372,6 +381,45 @@ class SimulatorNode:
         if self.drives.due(now):
             for io in self.io.values():
                 io.publish_drives(stamp)
+
+    def publish_performance(self, wall: float) -> None:
+        """/diagnostics once per ~diagnostics_rate period of wall time: the real-time factor reached, and
+        the process's CPU time per simulated second, all of it and pybullet's solver's part (the rest is
+        ROS and Python: messages in and out, the loop). A warning when a real-time factor asked for is
+        not held (below 90 %)."""
+        if wall - self.meter.last_wall < self.meter.period:
+            return
+        perf = self.meter.sample(wall, self.sim.time, time.process_time(), self.sim.solver_cpu)
+        if perf is None or not self.diagnostics.get_num_connections():
+            return
+        rtf = perf.real_time_factor
+        asked = self.real_time_factor
+        level = DiagnosticStatus.OK
+        if self.paused:
+            message = "paused"
+        else:
+            n = len(self.io)
+            message = f"{n} robot{'' if n == 1 else 's'}, {rtf:.2f} x real time"
+            if asked and rtf < 0.9 * asked:
+                level = DiagnosticStatus.WARN
+                message += f" (asked for {asked:g} x: the machine cannot keep up)"
+        values = {
+            "robots": len(self.io),
+            "simulated time [s]": f"{self.sim.time:.3f}",
+            "real-time factor": f"{rtf:.3f}",
+            "real-time factor asked": f"{asked:g}" if asked else "as fast as possible",
+            "physics rate [Hz]": f"{1.0 / self.sim.dt:g}",
+            "CPU per simulated second [s]": f"{perf.per_simulated_second(perf.cpu):.5f}",
+            "solver CPU per simulated second [s]": f"{perf.per_simulated_second(perf.solver_cpu):.5f}",
+            "CPU share [cores]": f"{perf.cpu / perf.wall:.3f}",
+        }
+        msg = DiagnosticArray(
+            status=[
+                conversions.diagnostic_status(rospy.get_name() + ": simulation", "pybullet", level, message, values)
+            ]
+        )
+        msg.header.stamp = rospy.Time.from_sec(self.sim.time)
+        self.diagnostics.publish(msg)
 
     def shutdown(self):
         with self.lock:

@@ -8,6 +8,9 @@ sequence on one robot; each compares the motion from just before the command to 
 has stopped. Where the two differ most is the start of a command that slews the steering while
 the wheels already drive (base_driver's drives, as the original's): odometry's model of wheels
 that disagree and the physics of them resolve differently.
+
+The simulator's /diagnostics: one robot, the real-time factor asked for (3) reached and never
+exceeded, and its CPU per simulated second with the solver's part.
 """
 
 import math
@@ -15,6 +18,7 @@ import unittest
 
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from sim_testing import Commander, Latest, drive, sim_sleep
 
 
@@ -54,6 +58,38 @@ class SimDriveTest(unittest.TestCase):
         self.assertAlmostEqual(truth[1], math.pi / 4, delta=math.radians(2))
         self.assertAlmostEqual(truth[0], odom[0], delta=0.02 * odom[0])
         self.assertAlmostEqual(truth[2], 0.0, delta=0.02)
+
+    def test_4_the_simulator_reports_how_it_runs_on_diagnostics(self):
+        statuses = []
+
+        def on_diagnostics(msg):
+            statuses.extend(s for s in msg.status if s.name == "/simulator: simulation")
+
+        sub = rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics)
+        try:
+            deadline = rospy.Time.now() + rospy.Duration(30.0)  # at least 10 s of wall time at 3x
+            while len(statuses) < 3 and rospy.Time.now() < deadline:
+                sim_sleep(0.5)
+        finally:
+            sub.unregister()
+        self.assertGreaterEqual(len(statuses), 3, "the simulator published no /diagnostics once a wall second")
+        status = statuses[-1]
+        values = {kv.key: kv.value for kv in status.values}
+        rospy.loginfo("simulator: %s %s", status.message, values)
+        self.assertEqual(values["robots"], "1")
+        self.assertEqual(values["real-time factor asked"], "3")
+        rtf = float(values["real-time factor"])
+        self.assertLess(rtf, 3.3)  # paced on the wall clock: never faster than asked
+        self.assertGreater(rtf, 0.5)
+        # below 90 % of the pace asked for it says so
+        self.assertEqual(status.level, DiagnosticStatus.WARN if rtf < 2.7 else DiagnosticStatus.OK, status.message)
+        cpu, solver = (
+            float(values["CPU per simulated second [s]"]),
+            float(values["solver CPU per simulated second [s]"]),
+        )
+        self.assertGreater(solver, 0.0)
+        self.assertLess(solver, cpu)  # the solver is a part of the process's CPU
+        self.assertLess(cpu, 1.0)  # one robot: far less than a core per simulated second here
 
 
 if __name__ == "__main__":

@@ -1,0 +1,53 @@
+"""The simulator's own measure of how it runs (its /diagnostics): windows of wall time, the
+real-time factor reached and CPU per simulated second, and the solver's part counted by Simulation."""
+
+import time
+
+import pybullet as p
+import pytest
+
+from thorvald_sim.simulation import Performance, PerformanceMeter, Simulation
+from thorvald_sim.world import parse_world
+
+
+def test_the_meter_reports_each_window_of_at_least_its_period():
+    meter = PerformanceMeter(period=1.0)
+    assert meter.sample(10.0, 0.0, 2.0, 1.0) is None  # the first sample opens the first window
+    assert meter.sample(10.6, 3.0, 2.3, 1.1) is None  # 0.6 s of wall time: too short
+    # 1.5 s of wall time from the window's start: 6 simulated seconds, 0.9 s of CPU, 0.3 s of it the solver
+    perf = meter.sample(11.5, 6.0, 2.9, 1.3)
+    assert perf == Performance(
+        wall=pytest.approx(1.5), simulated=6.0, cpu=pytest.approx(0.9), solver_cpu=pytest.approx(0.3)
+    )
+    assert perf.real_time_factor == pytest.approx(4.0)  # 6 s simulated in 1.5 s
+    assert perf.per_simulated_second(perf.cpu) == pytest.approx(0.15)  # 0.9 s / 6 s
+    assert perf.per_simulated_second(perf.solver_cpu) == pytest.approx(0.05)
+    assert meter.last_wall == 11.5  # the next window starts where this one ended
+    assert meter.sample(12.0, 8.0, 3.0, 1.4) is None
+
+
+def test_a_paused_window_reports_no_progress_and_no_division_by_zero():
+    meter = PerformanceMeter(period=1.0)
+    meter.sample(0.0, 5.0, 1.0, 0.5)
+    perf = meter.sample(2.0, 5.0, 1.01, 0.5)
+    assert perf.real_time_factor == 0.0
+    assert perf.per_simulated_second(perf.cpu) == 0.0
+
+
+def test_the_simulation_counts_the_cpu_its_solver_takes():
+    client = p.connect(p.DIRECT)
+    try:
+        sim = Simulation(client, parse_world({"ground": {"lateral_friction": 0.9}}, "flat"))
+        for k in range(40):  # something to collide: a stack of boxes on the ground
+            box = p.createCollisionShape(p.GEOM_BOX, halfExtents=(0.2, 0.2, 0.2), physicsClientId=client)
+            p.createMultiBody(1.0, box, basePosition=(0.1 * (k % 5), 0.0, 0.2 + 0.41 * k), physicsClientId=client)
+        cpu = time.thread_time()
+        for _ in range(240):
+            sim.step()
+        cpu = time.thread_time() - cpu
+        assert sim.steps == 240 and sim.time == pytest.approx(1.0)
+        # the solver's part of the steps: most of them (the loop around it is a few microseconds a step)
+        assert 0.0 < sim.solver_cpu <= cpu
+        assert sim.solver_cpu > 0.5 * cpu
+    finally:
+        p.disconnect(client)
