@@ -87,19 +87,22 @@ class CommandStream:
         while not rospy.is_shutdown():
             with self._lock:
                 if self._msg is not None:
-                    self.pub.publish(self._msg)
                     self.last_publish = time.time()
+                    self.pub.publish(self._msg)
             time.sleep(self.period)
 
     def send(self, msg):
         """Streams msg from now on (and publishes it at once)."""
         with self._lock:
             self._msg = msg
-            self.pub.publish(msg)
             self.last_publish = time.time()
+            self.pub.publish(msg)
 
     def stop(self):
-        """Stops streaming; returns the wall time [s] of the last message published."""
+        """Stops streaming; returns the wall time [s] just before the last message was published.
+
+        Before, not after: the node may receive and stamp a message before publish() returns here
+        (one CI run stamped a command 44 us before the time taken after publishing it)."""
         with self._lock:
             self._msg = None
             return self.last_publish

@@ -2,7 +2,7 @@
 """base_driver: a command older than ~command_timeout (0.5 s) stops the wheels and keeps the steering.
 
 Times are compared on the messages' stamps (the node's loop time, on the same clock as this test):
-the node stamps each command when it arrives, which is after this test published it, so the wheels
+the node stamps each command when it arrives, which is after this test began to publish it, so the wheels
 cannot stop before the last publication + 0.5 s, and must have stopped within one 50 Hz cycle after
 that; 0.2 s of margin absorbs a loaded machine.
 """
