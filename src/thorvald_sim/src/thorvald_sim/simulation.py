@@ -146,10 +146,10 @@ class PerformanceMeter:
         self.period = period
         self._start = None  # (wall, simulated, cpu, solver cpu) at the window's start
 
-    @property
-    def last_wall(self) -> float:
-        """[s] wall time the current window started (-inf before the first sample)."""
-        return self._start[0] if self._start else float("-inf")
+    def due(self, wall: float) -> bool:
+        """Whether a sample at wall [s] would end a window (or start the first): the caller reads its
+        clocks only then."""
+        return self._start is None or wall - self._start[0] >= self.period
 
     def sample(self, wall: float, simulated: float, cpu: float, solver_cpu: float) -> Optional[Performance]:
         """The Performance of the window that ends here, or None while it is shorter than period."""
@@ -157,7 +157,7 @@ class PerformanceMeter:
         if self._start is None:
             self._start = now
             return None
-        if wall - self._start[0] < self.period:
+        if not self.due(wall):
             return None
         start, self._start = self._start, now
         return Performance(*(b - a for a, b in zip(start, now)))

@@ -232,8 +232,7 @@ class SimulatorNode:
         self.clock_pub = NonBlockingPublisher("/clock", Clock)
         self.tf = NonBlockingPublisher("/tf", TFMessage)
         self.diagnostics = NonBlockingPublisher("/diagnostics", DiagnosticArray)
-        self.meter = PerformanceMeter(1.0 / diagnostics_rate if diagnostics_rate else float("inf"))
-        self.diagnostics_rate = diagnostics_rate
+        self.meter = PerformanceMeter(1.0 / diagnostics_rate) if diagnostics_rate else None
         rospy.Service("~pause", Empty, self.srv_pause)
         rospy.Service("~unpause", Empty, self.srv_unpause)
         rospy.Service("~reset", Empty, self.srv_reset)
@@ -330,7 +329,7 @@ class SimulatorNode:
                         io.apply(now, self.command_timeout)
                     self.sim.step()
                     self.publish(self.sim.time)
-            if self.diagnostics_rate:
+            if self.meter is not None:
                 self.publish_performance(time.monotonic())
             if paused:
                 anchor = None
@@ -387,7 +386,7 @@ class SimulatorNode:
         the process's CPU time per simulated second, all of it and pybullet's solver's part (the rest is
         ROS and Python: messages in and out, the loop). A warning when a real-time factor asked for is
         not held (below 90 %)."""
-        if wall - self.meter.last_wall < self.meter.period:
+        if not self.meter.due(wall):
             return
         perf = self.meter.sample(wall, self.sim.time, time.process_time(), self.sim.solver_cpu)
         if perf is None or not self.diagnostics.get_num_connections():

@@ -12,7 +12,8 @@ from thorvald_sim.world import parse_world
 
 def test_the_meter_reports_each_window_of_at_least_its_period():
     meter = PerformanceMeter(period=1.0)
-    assert meter.sample(10.0, 0.0, 2.0, 1.0) is None  # the first sample opens the first window
+    assert meter.due(10.0)  # the first sample is always due: it opens the first window
+    assert meter.sample(10.0, 0.0, 2.0, 1.0) is None
     assert meter.sample(10.6, 3.0, 2.3, 1.1) is None  # 0.6 s of wall time: too short
     # 1.5 s of wall time from the window's start: 6 simulated seconds, 0.9 s of CPU, 0.3 s of it the solver
     perf = meter.sample(11.5, 6.0, 2.9, 1.3)
@@ -22,7 +23,7 @@ def test_the_meter_reports_each_window_of_at_least_its_period():
     assert perf.real_time_factor == pytest.approx(4.0)  # 6 s simulated in 1.5 s
     assert perf.per_simulated_second(perf.cpu) == pytest.approx(0.15)  # 0.9 s / 6 s
     assert perf.per_simulated_second(perf.solver_cpu) == pytest.approx(0.05)
-    assert meter.last_wall == 11.5  # the next window starts where this one ended
+    assert not meter.due(12.4) and meter.due(12.5)  # the next window starts where this one ended
     assert meter.sample(12.0, 8.0, 3.0, 1.4) is None
 
 
