@@ -13,7 +13,8 @@ Private parameters besides the configuration:
 ``~simple_sim``                    simulate the drives (true) or drive the real base over CAN
 ``~base_handle``                   the base handle (thorvald_base.bases): default
                                    ``simple_sim`` with simple_sim true, else ``can``
-``~tf_prefix``                     prefix of frame and joint names, concatenated (``robot_1/``)
+``~tf_prefix``                     prefix of frame and joint names: ``robot_1/`` or the older
+                                   original's ``robot_1``, both giving ``robot_1/base_link``
 ``~enable_odom_tf``                broadcast odom -> base_link (default true)
 ``~odom_frame_id``                 default ``odom``
 ``~passthrough_gazebo_odometry``   republish ``odometry/gazebo`` (a simulator's ground truth)
@@ -46,6 +47,7 @@ from sensor_msgs.msg import BatteryState, JointState
 from std_srvs.srv import SetBool, SetBoolResponse, Trigger, TriggerResponse
 
 from thorvald_model import ConfigError, load_robot_config, parse_robot_config
+from thorvald_model.frames import normalize_tf_prefix
 from thorvald_msgs.msg import BaseState, BatteryArray, CANFrame, ControllerArray, IOArray
 from thorvald_msgs.srv import (
     CanID,
@@ -114,7 +116,7 @@ class BaseDriverNode:
     def __init__(self):
         params = rospy.get_param("~", {})
         self.config, from_file = load_config(params)
-        self.tf_prefix = str(params.get("tf_prefix", ""))
+        self.tf_prefix = normalize_tf_prefix(params.get("tf_prefix", ""))
         self.odom_frame = str(params.get("odom_frame_id", "odom"))
         self.base_frame = self.tf_prefix + "base_link"
         self.enable_tf = bool(params.get("enable_odom_tf", True))

@@ -43,10 +43,16 @@ def quaternion_yaw(q: Quaternion) -> float:
 
 
 def joint_names(drives: Sequence, tf_prefix: str = "") -> List[str]:
-    """``<tf_prefix>steeringN``, ``<tf_prefix>wheelN`` per drive, in drive order (the original's)."""
+    """``<tf_prefix>steeringN``, ``<tf_prefix>wheelN`` per drive, in drive order (the original's).
+
+    Only joints the description moves: a drive that cannot steer (type 1) has a fixed steering
+    joint, which robot_state_publisher would warn about in every message.
+    """
     names = []
     for d in drives:
-        names += [tf_prefix + d.steering_name, tf_prefix + d.wheel_name]
+        if d.steerable:
+            names.append(tf_prefix + d.steering_name)
+        names.append(tf_prefix + d.wheel_name)
     return names
 
 
@@ -98,11 +104,15 @@ def joint_state_msg(stamp, names: Sequence[str], positions: Sequence[float], vel
 
 
 def drive_joint_state_msg(stamp, names: Sequence[str], drives: Sequence, states: Sequence[MeasuredDrive]) -> JointState:
-    """joint_states of the drives: per drive the steering (angle, rate) then the wheel (angle, angular speed)."""
+    """joint_states of the drives: per drive the steering (angle, rate) then the wheel (angle, angular
+    speed); names as :func:`joint_names` gives them (no steering for a drive that cannot steer)."""
     positions, velocities = [], []
     for d, s in zip(drives, states):
-        positions += [s.steering, s.wheel_angle]
-        velocities += [s.steering_speed, s.speed / d.r_wheel]
+        if d.steerable:
+            positions.append(s.steering)
+            velocities.append(s.steering_speed)
+        positions.append(s.wheel_angle)
+        velocities.append(s.speed / d.r_wheel)
     return joint_state_msg(stamp, names, positions, velocities)
 
 

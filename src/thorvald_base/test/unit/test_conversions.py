@@ -1,6 +1,7 @@
 """Message conversions (thorvald_base.conversions): the message types, no ROS master."""
 
 import math
+import xml.etree.ElementTree as ET
 
 import pytest
 from base_test_helpers import EXAMPLE_ROBOTS
@@ -11,6 +12,7 @@ from thorvald_base import conversions
 from thorvald_base.bases import BatteryInfo, ControllerInfo, Frame, IoInfo, MeasuredDrive
 from thorvald_base.kinematics import DriveCommand, OdometryResult, Pose, Twist
 from thorvald_model import load_robot_config
+from thorvald_model.description import generate_urdf
 from thorvald_msgs.msg import CANFrame
 
 STAMP = Time(12, 500)
@@ -62,6 +64,23 @@ def test_joint_states_give_wheel_angular_speed():
     msg = conversions.drive_joint_state_msg(STAMP, names, config.drives, states)
     # wheel angular speed = rim speed / r_wheel = 0.5 / 0.2
     assert list(msg.position[:2]) == [0.3, 1.0] and list(msg.velocity[:2]) == [0.1, 2.5]
+
+
+def test_joint_states_name_only_joints_the_description_moves():
+    """A type-1 drive's steering joint is fixed in the description: robot_state_publisher warns for
+    every joint_states message that names it, so base_driver leaves it out."""
+    config = robot("thorvald_ii_2wd_diff")
+    names = conversions.joint_names(config.drives, "r/")
+    assert names == ["r/wheel0", "r/wheel1"]
+    urdf = ET.fromstring(generate_urdf(config.source, tf_prefix="r/"))
+    moving = {j.get("name") for j in urdf.findall("joint") if j.get("type") != "fixed"}
+    assert set(names) <= moving
+    states = [MeasuredDrive(0.0, 0.4, 1.5, 0.0), MeasuredDrive(0.0, -0.4, -1.5, 0.0)]
+    msg = conversions.drive_joint_state_msg(STAMP, names, config.drives, states)
+    # wheel angle, then rim speed / r_wheel per wheel
+    r = config.drives[0].r_wheel
+    assert list(msg.name) == names
+    assert list(msg.position) == [1.5, -1.5] and list(msg.velocity) == [0.4 / r, -0.4 / r]
 
 
 def test_odometry_and_its_transform():

@@ -24,6 +24,7 @@ import yaml
 
 from .config import load_robot_config, parse_robot_config
 from .errors import ConfigError, ThorvaldModelError
+from .frames import normalize_tf_prefix
 from .resources import package_folder
 
 # The package folder when this module runs from the source tree (or the devel space, which relays
@@ -111,15 +112,18 @@ def _eval_extension(text: str, _original: Callable[[str], Any]) -> Any:
 
 @contextlib.contextmanager
 def shared_loader() -> Iterator[None]:
-    """Within the block, xacro's load_yaml() is :func:`_load_yaml` and $(arg) needs no roslaunch."""
+    """Within the block, xacro's load_yaml() is :func:`_load_yaml`, $(arg) needs no roslaunch, and
+    ``normalize_tf_prefix()`` is the one rule of :mod:`thorvald_model.frames` for the xacro."""
     previous_load = xacro.global_symbols.get("load_yaml")
     previous_extension = xacro.eval_extension
     xacro.global_symbols["load_yaml"] = _load_yaml
+    xacro.global_symbols["normalize_tf_prefix"] = normalize_tf_prefix
     xacro.eval_extension = functools.partial(_eval_extension, _original=previous_extension)
     try:
         yield
     finally:
         xacro.global_symbols["load_yaml"] = previous_load
+        xacro.global_symbols.pop("normalize_tf_prefix", None)
         xacro.eval_extension = previous_extension
 
 
