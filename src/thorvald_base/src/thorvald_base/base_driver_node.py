@@ -170,9 +170,15 @@ class BaseDriverNode:
         rospy.Service("~mute_extra_can_device_commands", SetBool, self.srv_mute)
         rospy.Service("~setup_motor_controller", MotorControllerSetup, self.srv_setup_motor_controller)
         rospy.Service("~set_home_count_current_pos_zero", CanID, self.srv_set_home_count)
-        for board in self.config.io:
+        boards = handle.io_config
+        for board in boards:
             for relay in range(2):
                 rospy.Service(f"~io{board.id}_rl{relay}", SetBool, self._relay_service(board.id, relay))
+        main = next((b for b in boards if b.is_main), None)
+        if main is not None:
+            # the original's names of the main board's relays, 1-based (LCAS: setRl1 lights, setRl2 AC)
+            for relay in range(2):
+                rospy.Service(f"~setRl{relay + 1}", SetBool, self._relay_service(main.id, relay))
         self._last_status_publish = None
         self._link_logged = {}
         rospy.loginfo(

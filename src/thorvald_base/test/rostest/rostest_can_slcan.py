@@ -4,8 +4,9 @@
 Commands reach the wheels and come back as measured states; a motor controller silenced mid-drive
 stops every wheel once it has been silent for 2 s and is reported, and control resumes when it is
 heard again; the relay works both ways with an implement on the hub's second port, refuses a frame
-to a base controller's command id, and is muted by the service; the adapter unplugged and plugged
-back: base_driver survives, reports, and drives again.
+to a base controller's command id, and is muted by the service; the main IO board's relays switch
+by the original's service names (setRl1, setRl2) without an io section in the robot file; the
+adapter unplugged and plugged back: base_driver survives, reports, and drives again.
 """
 
 import os
@@ -20,7 +21,7 @@ from driver_testing import STARTUP_TIMEOUT, Topic, driver_service, driver_stream
 from nav_msgs.msg import Odometry
 from std_srvs.srv import SetBool, Trigger
 
-from thorvald_msgs.msg import BaseState, CANFrame, ControllerArray
+from thorvald_msgs.msg import BaseState, CANFrame, ControllerArray, IOArray
 
 SPEED = 0.5  # [m/s]
 LOST_AFTER = 2.0  # [s] the rule: a device silent this long is lost
@@ -125,6 +126,29 @@ class CanSlcanTest(unittest.TestCase):
             self.assertTrue(relayed(0x126, b"\x02"), "relaying did not resume after unmuting")
         finally:
             implement.shutdown()
+
+    def test_3b_the_main_board_relays_by_the_original_names(self):
+        """The robot file has no io section: the main enclosure PCB (id 0) is on the bus all the same,
+        and setRl1 / setRl2 (the original's names) switch its relays 0 and 1, as io0_rl0 / io0_rl1."""
+        io = Topic("io_data", IOArray)
+
+        def relays(expected):
+            msg = io.wait_for(
+                lambda m: any(b.id == 0 and b.online and list(b.relay_states) == expected for b in m.ios),
+                timeout=5.0,
+            )
+            return msg is not None
+
+        self.assertTrue(relays([False, False]), "the main board never reported online with its relays off")
+        set_rl1, set_rl2 = driver_service("setRl1", SetBool), driver_service("setRl2", SetBool)
+        self.assertTrue(set_rl1(True).success)
+        self.assertTrue(relays([True, False]), "setRl1 did not switch the main board's first relay on")
+        self.assertTrue(set_rl2(True).success)
+        self.assertTrue(relays([True, True]), "setRl2 did not switch the main board's second relay on")
+        self.assertTrue(set_rl1(False).success)
+        self.assertTrue(relays([False, True]), "setRl1 did not switch it off again")
+        self.assertTrue(driver_service("io0_rl1", SetBool)(False).success)
+        self.assertTrue(relays([False, False]), "io0_rl1 did not switch the second relay off")
 
     def test_4_the_adapter_unplugged_and_back(self):
         self.cmd.send(twist(SPEED))

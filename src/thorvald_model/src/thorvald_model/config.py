@@ -18,7 +18,14 @@ import re
 from dataclasses import dataclass, field, replace
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Tuple
 
-from .constants import DIFF_CALCULATOR, DRIVE_DIFF, DRIVE_STEERED, ONE_WHEEL_CALCULATOR, STD_CALCULATOR
+from .constants import (
+    DIFF_CALCULATOR,
+    DRIVE_DIFF,
+    DRIVE_STEERED,
+    IO_MAIN_BOARD,
+    ONE_WHEEL_CALCULATOR,
+    STD_CALCULATOR,
+)
 from .errors import MISSING, ConfigError, Problem
 from .layout import layout_problems
 from .schema import (
@@ -191,6 +198,14 @@ class IOBoard:
     rl0_init_state: bool
     rl1_init_state: bool
 
+    @property
+    def is_main(self) -> bool:
+        """The main enclosure PCB: its relays are the original's ``setRl1`` and ``setRl2``."""
+        return self.type == IO_MAIN_BOARD
+
+
+DEFAULT_MAIN_IO_BOARD = IOBoard("io0", 0, id=0, type=IO_MAIN_BOARD, rl0_init_state=False, rl1_init_state=False)
+
 
 @dataclass(frozen=True)
 class PassiveWheel:
@@ -253,6 +268,12 @@ class RobotConfig:
     suspensions: Tuple[Suspension, ...] = ()
     frame_parts: Tuple[FramePart, ...] = ()
     extras: Tuple[Tuple[str, Any], ...] = field(default=(), compare=False)
+
+    @property
+    def io_boards_on_bus(self) -> Tuple[IOBoard, ...]:
+        """The IO boards on the robot's CAN bus: the ``io`` section's, or, without one, the main
+        enclosure PCB every Thorvald has (the original's default board, id 0, relays off at start)."""
+        return self.io or (DEFAULT_MAIN_IO_BOARD,)
 
     def drive(self, name: str) -> Drive:
         for d in self.drives:

@@ -11,3 +11,6 @@ DRIVE_STEERED = 0
 """Drive type 0: propulsion + steering module (one motor controller per drive)."""
 DRIVE_DIFF = 1
 """Drive type 1: propulsion only, rolling along base_link x; two share one dual-channel controller."""
+
+IO_MAIN_BOARD = 0
+"""IO board type 0: the main enclosure PCB (1: sister enclosure PCB, 2: UV lamp board)."""

@@ -363,6 +363,20 @@ def test_io_board_type(robot):
     assert_problem(robot, "io.io0.type", "UV lamp")
 
 
+def test_the_main_io_board_is_on_the_bus_without_an_io_section(robot):
+    """The original's default board: a robot file without io still has the main enclosure PCB on
+    its CAN bus (id 0, type 0, relays off at start); an io section replaces it."""
+    config = parse_robot_config(robot)
+    assert config.io == ()
+    (main,) = config.io_boards_on_bus
+    assert (main.id, main.type, main.rl0_init_state, main.rl1_init_state) == (0, 0, False, False)
+    assert main.is_main
+    robot["io"] = {"io0": {"id": 3, "type": 1}, "io1": {"id": 5, "type": 0, "rl1_init_state": 1}}
+    config = parse_robot_config(robot)
+    assert [(b.id, b.is_main) for b in config.io_boards_on_bus] == [(3, False), (5, True)]
+    assert config.io_boards_on_bus == config.io
+
+
 def test_pipe_ends_differ(robot):
     robot["pipes"] = {"pipe0": {"x1": 0.3, "y1": 0.3, "x2": 0.3, "y2": 0.3}}
     assert_problem(robot, "pipes.pipe0", "two ends must differ")

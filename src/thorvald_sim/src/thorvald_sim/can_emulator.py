@@ -126,7 +126,7 @@ class CanEmulator:
             for node, ds in by_node.items()
         }
         self.batteries = {b.id: EmulatedBattery(b.id) for b in config.batteries if b.type == 1 and b.with_battery}
-        self.ios = {b.id: EmulatedIo(b.id, b.type, [False, False]) for b in config.io}
+        self.ios = {b.id: EmulatedIo(b.id, b.type, [False, False]) for b in config.io_boards_on_bus}
         self.to_corrupt = 0
         self.sent = 0
         self.received = 0

@@ -111,7 +111,7 @@ class CanBase(BaseHandle):
                 MotorController(node, drives, sorted(indices, key=lambda k: config.drives[k].channel))
             )
         self.batteries_ = [Battery(b) for b in config.batteries if b.type == 1 and b.with_battery]
-        self.ios = [IoBoard(b) for b in config.io]
+        self.ios = [IoBoard(b) for b in self.io_config]
         try:
             self.owned = pr.device_ids(
                 [c.node for c in self.controllers_], [b.id for b in self.batteries_], [b.id for b in self.ios]
@@ -130,6 +130,11 @@ class CanBase(BaseHandle):
         self.muted = False
         self.allow_relay_to_base = False
         self._pending: List[Tuple[int, bytes]] = [b.command_frame(b.initial) for b in self.ios]
+
+    @property
+    def io_config(self):
+        # the main enclosure PCB is on every robot's bus, named in the robot file or not
+        return self.config.io_boards_on_bus
 
     @classmethod
     def from_params(cls, config, params):

@@ -163,6 +163,11 @@ class BaseHandle:
         self.config = config
         self._set_params(config)
 
+    @property
+    def io_config(self):
+        """The IO boards of this base (thorvald_model IOBoard): the relay services base_driver offers."""
+        return self.config.io
+
     def batteries(self, time: float) -> List[BatteryInfo]:
         return []
 
