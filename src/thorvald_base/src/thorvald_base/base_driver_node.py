@@ -181,6 +181,8 @@ class BaseDriverNode:
                 rospy.Service(f"~setRl{relay + 1}", SetBool, self._relay_service(main.id, relay))
         self._last_status_publish = None
         self._link_logged = {}
+        for warning in self.config.warnings:
+            rospy.logwarn("base_driver: %s", warning.format(self.config.source))
         rospy.loginfo(
             "base_driver: %d drives, calculator %s, base %s, %.0f Hz, odom tf %s",
             len(self.config.drives),

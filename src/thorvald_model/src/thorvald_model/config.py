@@ -13,6 +13,7 @@ Loading never stops at the first mistake: every problem is collected, each with 
 path, the value and the rule, and raised together in one :class:`ConfigError`.
 """
 
+import logging
 import math
 import re
 from dataclasses import dataclass, field, replace
@@ -31,6 +32,7 @@ from .layout import layout_problems
 from .schema import (
     NON_NEGATIVE,
     POSITIVE,
+    Kept,
     Key,
     check_top_level,
     in_range,
@@ -267,7 +269,11 @@ class RobotConfig:
     passive_wheels: Tuple[PassiveWheel, ...] = ()
     suspensions: Tuple[Suspension, ...] = ()
     frame_parts: Tuple[FramePart, ...] = ()
+    # Top-level keys for the user's own files (the sensor keys, and unknown ones kept), and unknown
+    # keys kept inside entries: (section, entry, key, value). to_dict() gives them back.
     extras: Tuple[Tuple[str, Any], ...] = field(default=(), compare=False)
+    entry_extras: Tuple[Tuple[str, str, str, Any], ...] = field(default=(), compare=False)
+    warnings: Tuple[Problem, ...] = field(default=(), compare=False)  # each unknown key kept
 
     @property
     def io_boards_on_bus(self) -> Tuple[IOBoard, ...]:
@@ -308,6 +314,8 @@ class RobotConfig:
             if items:
                 out[section.key] = {item.name: _item_to_dict(section, item) for item in items}
         out.update(dict(self.extras))
+        for section_key, entry, key, value in self.entry_extras:
+            out[section_key][entry][key] = value
         return out
 
     def with_drive_param(self, index: int, key: str, value: Any) -> "RobotConfig":
@@ -456,7 +464,8 @@ SECTIONS = (
     Section("suspensions", "susp", SUSPENSION_KEYS, Suspension, "suspensions"),
     Section("frame_parts", "part", FRAME_PART_KEYS, FramePart, "frame_parts"),
 )
-TOP_LEVEL_KEYS = ("base_calculator", *(s.key for s in SECTIONS), *PASSTHROUGH_KEYS)
+SCHEMA_TOP_LEVEL_KEYS = ("base_calculator", *(s.key for s in SECTIONS))
+TOP_LEVEL_KEYS = (*SCHEMA_TOP_LEVEL_KEYS, *PASSTHROUGH_KEYS)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -478,8 +487,9 @@ def parse_robot_config(data: Any, source: str = "<robot configuration>", ignore:
     parameters beside the robot configuration in its private namespace).
     """
     problems: List[Problem] = []
+    kept: List[Kept] = []
     try:
-        data = check_top_level(data, TOP_LEVEL_KEYS, problems, ignore)
+        data = check_top_level(data, TOP_LEVEL_KEYS, problems, ignore, kept=kept, mistakable=SCHEMA_TOP_LEVEL_KEYS)
     except ConfigError as e:
         raise ConfigError(source, e.problems) from None
 
@@ -495,10 +505,13 @@ def parse_robot_config(data: Any, source: str = "<robot configuration>", ignore:
 
     parsed = {}
     for section in SECTIONS:
-        entries = parse_section(data.get(section.key), section.key, section.prefix, section.keys, problems)
+        entries = parse_section(data.get(section.key), section.key, section.prefix, section.keys, problems, kept=kept)
         parsed[section.attr] = [_build(section, name, index, values) for name, index, values in entries]
 
     extras = tuple((k, data[k]) for k in PASSTHROUGH_KEYS if k in data)
+    extras += tuple((k.path[0], k.value) for k in kept if len(k.path) == 1)
+    built = {(section.key, item.name) for section in SECTIONS for item in parsed[section.attr]}
+    entry_extras = tuple((*k.path, k.value) for k in kept if len(k.path) == 3 and tuple(k.path[:2]) in built)
     drives = _attach_channels(_attach_suspensions(parsed["drives"], parsed["suspensions"]))
     config = RobotConfig(
         source=source,
@@ -513,11 +526,30 @@ def parse_robot_config(data: Any, source: str = "<robot configuration>", ignore:
         suspensions=tuple(parsed["suspensions"]),
         frame_parts=tuple(parsed["frame_parts"]),
         extras=extras,
+        entry_extras=entry_extras,
+        warnings=tuple(k.problem() for k in kept),
     )
     problems.extend(_cross_field_problems(config, data))
     if problems:
         raise ConfigError(source, problems)
+    _log_kept_keys(config)
     return config
+
+
+_log = logging.getLogger(__name__)
+_logged = set()  # (source, key path): each kept key is logged once per process, however often loaded
+
+
+def _log_kept_keys(config: RobotConfig) -> None:
+    """One warning per unknown key kept (as the original, which ignored them, but said here).
+
+    Without a logging set-up Python prints a warning's text alone on stderr (the command-line
+    tools); a node logs it in its log file, and base_driver says it on rosout too.
+    """
+    for problem in config.warnings:
+        if (config.source, problem.path) not in _logged:
+            _logged.add((config.source, problem.path))
+            _log.warning(problem.format(config.source))
 
 
 _CALCULATOR_NAME = re.compile(r"^(\w+::\w+|[A-Za-z_][\w.]*:\w+)$")

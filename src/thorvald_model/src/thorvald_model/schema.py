@@ -50,6 +50,26 @@ def in_range(lo, hi):
 
 
 POSITIVE = dict(check=positive, rule="must be > 0")
+
+# How alike (difflib's ratio) an unknown key must be to a known one to be taken for its typing
+# mistake: r_wheeel for r_wheel (0.93), motor_drive for motor_drives (0.96). Less alike keys are
+# the user's own, kept where a file allows it (:class:`Kept`).
+CLOSE_KEY = 0.8
+KEPT_RULE = "unknown key, kept as it is for the user's own files (nothing here reads it)"
+
+
+@dataclass(frozen=True)
+class Kept:
+    """An unknown key kept with its value: where it was (the key path as parts) and what it held."""
+
+    path: Tuple[str, ...]
+    value: Any
+
+    def problem(self) -> Problem:
+        """The warning that says it was kept."""
+        return Problem(".".join(self.path), short(self.value), KEPT_RULE)
+
+
 NON_NEGATIVE = dict(check=non_negative, rule="must be >= 0")
 
 
@@ -77,9 +97,19 @@ def read_yaml_file(path: str, what: str = "robot configuration") -> Any:
         raise ConfigError(path, [Problem("", MISSING, f"not valid YAML{where}: {reason}")], what) from None
 
 
-def check_top_level(data: Any, known: Sequence[str], problems: List[Problem], ignore: Iterable[str] = ()) -> Mapping:
+def check_top_level(
+    data: Any,
+    known: Sequence[str],
+    problems: List[Problem],
+    ignore: Iterable[str] = (),
+    *,
+    kept: Optional[List[Kept]] = None,
+    mistakable: Optional[Sequence[str]] = None,
+) -> Mapping:
     """The document as a mapping (empty for an empty file); a problem for each unknown top-level key.
 
+    With a ``kept`` list, an unknown key unlike any of ``mistakable`` (default: every known key) is
+    the user's own and goes there instead; one like a known key stays a problem ("did you mean").
     Raises ConfigError at once when the document is not a mapping at all (there is nothing more to check).
     """
     if data is None:
@@ -89,7 +119,10 @@ def check_top_level(data: Any, known: Sequence[str], problems: List[Problem], ig
     ignore = set(ignore)
     for key in data:
         if key not in known and key not in ignore:
-            problems.append(Problem(str(key), short(data[key]), unknown_key_rule(key, known)))
+            if kept is not None and close_key(key, known if mistakable is None else mistakable) is None:
+                kept.append(Kept((str(key),), data[key]))
+            else:
+                problems.append(Problem(str(key), short(data[key]), unknown_key_rule(key, known)))
     return data
 
 
@@ -97,12 +130,18 @@ _ENTRY_NAME = re.compile(r"^([a-z_]+?)(\d+)$")
 
 
 def parse_section(
-    raw: Any, key: str, prefix: str, keys: Sequence[Key], problems: List[Problem]
+    raw: Any,
+    key: str,
+    prefix: str,
+    keys: Sequence[Key],
+    problems: List[Problem],
+    *,
+    kept: Optional[List[Kept]] = None,
 ) -> List[Tuple[str, int, dict]]:
     """(name, index, values) of each valid entry of a section, in index order.
 
     raw: the section's value (None for an absent section); key: its top-level key, e.g.
-    ``motor_drives``; prefix: the entries' name, e.g. ``drive``.
+    ``motor_drives``; prefix: the entries' name, e.g. ``drive``; kept: as :func:`parse_entry`.
     """
     if raw is None:
         return []
@@ -116,25 +155,33 @@ def parse_section(
         if not m or m.group(1) != prefix or (len(m.group(2)) > 1 and m.group(2).startswith("0")):
             problems.append(Problem(path, MISSING, f"entries must be named {prefix}0, {prefix}1, ..."))
             continue
-        indexed[int(m.group(2))] = (str(name), parse_entry(entry, path, keys, problems))
+        indexed[int(m.group(2))] = (str(name), parse_entry(entry, path, keys, problems, kept=kept))
     for expected, index in enumerate(sorted(indexed)):
         if index != expected:
+            # The original read robot files' entries until one was missing and silently dropped the rest.
+            read = ", ".join(indexed[i][0] for i in sorted(indexed) if i < expected) or "none"
+            dropped = ", ".join(indexed[i][0] for i in sorted(indexed) if i > expected)
             problems.append(
                 Problem(
                     f"{key}.{prefix}{expected}",
                     MISSING,
-                    f"entries must be numbered from {prefix}0 without gaps ({prefix}{index} is there)",
+                    f"entries must be numbered from {prefix}0 without gaps: read in order (as the original "
+                    f"read them), they stop after {read} at the missing {prefix}{expected}, and {dropped} "
+                    "would be dropped",
                 )
             )
             break
     return [(indexed[i][0], i, indexed[i][1]) for i in sorted(indexed) if indexed[i][1] is not None]
 
 
-def parse_entry(entry: Any, path: str, keys: Sequence[Key], problems: List[Problem]) -> Optional[dict]:
+def parse_entry(
+    entry: Any, path: str, keys: Sequence[Key], problems: List[Problem], *, kept: Optional[List[Kept]] = None
+) -> Optional[dict]:
     """The entry's values with defaults filled in; None if a required key is missing or invalid.
 
     An invalid value of a key that has a default is replaced by the default after its problem is
-    recorded, so the cross-field rules can still look at the rest of the entry.
+    recorded, so the cross-field rules can still look at the rest of the entry. With a ``kept``
+    list, an unknown key unlike every known one is kept there (see :func:`check_top_level`).
     """
     if not isinstance(entry, Mapping):
         problems.append(Problem(path, short(entry), "must be a mapping of keys"))
@@ -150,7 +197,10 @@ def parse_entry(entry: Any, path: str, keys: Sequence[Key], problems: List[Probl
         key_path = f"{path}.{raw_key}"
         key = by_name.get(raw_key)
         if key is None:
-            problems.append(Problem(key_path, raw_value, unknown_key_rule(raw_key, list(by_name))))
+            if kept is not None and close_key(raw_key, by_name) is None:
+                kept.append(Kept((*path.split("."), str(raw_key)), raw_value))
+            else:
+                problems.append(Problem(key_path, raw_value, unknown_key_rule(raw_key, list(by_name))))
             continue
         if key.name in seen_as:
             problems.append(Problem(key_path, raw_value, f"'{raw_key}' is already given as '{seen_as[key.name]}'"))
@@ -206,6 +256,12 @@ def coerce(value: Any, kind: type) -> Tuple[bool, Any]:
             return False, None
         return True, int(value)
     return True, float(value)
+
+
+def close_key(key: Any, known: Iterable[str]) -> Optional[str]:
+    """The known key that ``key`` most likely mistypes, or None."""
+    close = difflib.get_close_matches(str(key), sorted(set(known)), n=1, cutoff=CLOSE_KEY)
+    return close[0] if close else None
 
 
 def unknown_key_rule(key: Any, known: Iterable[str]) -> str:

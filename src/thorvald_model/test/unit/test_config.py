@@ -71,9 +71,58 @@ def test_sensor_keys_of_user_extras_pass_through(robot):
 def test_ignored_keys_let_a_node_parse_its_private_namespace(robot):
     robot["simple_sim"] = True
     robot["tf_prefix"] = "robot_1/"
-    assert_problem(dict(robot), "simple_sim", "unknown key")
+    assert [w.path for w in parse_robot_config(dict(robot)).warnings] == ["simple_sim", "tf_prefix"]
     config = parse_robot_config(robot, ignore=("simple_sim", "tf_prefix"))
-    assert len(config.drives) == 4
+    assert len(config.drives) == 4 and config.warnings == ()
+
+
+# --- keys we do not know: a typing mistake is an error, the user's own keys are kept -----------------
+def test_unknown_keys_unlike_ours_are_kept_with_a_warning(robot, caplog):
+    """As the original, which ignored keys it did not know; kept, so a user's xacro extras can read
+    them from the configuration the model gets (to_dict), and said once."""
+    robot["sensor_mast"] = {"height": 2.1}
+    robot["motor_drives"]["drive1"]["hub_motor_make"] = "ACME"
+    robot["batteries"] = {"bat0": {"id": 1, "colour_code": 7}}
+    source = "kept_keys_robot.yaml"
+    with caplog.at_level("WARNING", logger="thorvald_model"):
+        config = parse_robot_config(robot, source)
+        parse_robot_config(config.to_dict(), source)  # loaded again: no second warning
+    assert [(w.path, w.value) for w in config.warnings] == [
+        ("sensor_mast", {"height": 2.1}),
+        ("motor_drives.drive1.hub_motor_make", "ACME"),
+        ("batteries.bat0.colour_code", 7),
+    ]
+    assert all("unknown key, kept" in w.rule for w in config.warnings)
+    assert sorted(r.getMessage() for r in caplog.records) == sorted(w.format(source) for w in config.warnings)
+    out = config.to_dict()
+    assert out["sensor_mast"] == {"height": 2.1}
+    assert out["motor_drives"]["drive1"]["hub_motor_make"] == "ACME"
+    assert out["batteries"]["bat0"]["colour_code"] == 7
+    assert "hub_motor_make" not in out["motor_drives"]["drive0"]
+
+
+@pytest.mark.parametrize(
+    "path, key, meant",
+    [
+        (("motor_drives", "drive2"), "r_wheeel", "r_wheel"),
+        (("motor_drives", "drive0"), "prp_gr_rate", "prp_gr_rt"),
+        ((), "motor_drive", "motor_drives"),
+        ((), "batterys", "batteries"),
+        (("batteries", "bat0"), "with_batery", "with_battery"),
+    ],
+)
+def test_a_key_like_one_of_ours_stays_an_error(robot, path, key, meant):
+    robot["batteries"] = {"bat0": {"id": 1}}
+    entry = robot
+    for part in path:
+        entry = entry[part]
+    entry[key] = entry.get(meant, 1) if path else entry.pop(meant, {"bat0": {"id": 1}})
+    assert_problem(robot, ".".join((*path, key)), f"did you mean '{meant}'?")
+
+
+def test_sensor_keys_of_users_stay_silent(robot):
+    robot["imu"] = {"parent_link": "top0"}
+    assert parse_robot_config(robot).warnings == ()
 
 
 # --- values ----------------------------------------------------------------------------------
@@ -171,6 +220,16 @@ def test_drives_numbered_without_gaps(robot):
     # The original reads drive0, drive1, ... until one is missing: drive3 after a gap would be lost.
     robot["motor_drives"]["drive5"] = robot["motor_drives"].pop("drive3")
     assert_problem(robot, "motor_drives.drive3", "without gaps", "drive5")
+
+
+def test_a_gap_says_which_entries_the_original_would_drop(robot):
+    drives = robot["motor_drives"]
+    drives["drive4"], drives["drive6"] = drives.pop("drive2"), drives.pop("drive3")
+    p = assert_problem(robot, "motor_drives.drive2", "without gaps")
+    assert "stop after drive0, drive1 at the missing drive2, and drive4, drive6 would be dropped" in p.rule
+    robot["motor_drives"] = {"drive1": drives["drive1"]}
+    p = assert_problem(robot, "motor_drives.drive0", "without gaps")
+    assert "stop after none at the missing drive0, and drive1 would be dropped" in p.rule
 
 
 # --- cross-field rules -----------------------------------------------------------------------
@@ -413,7 +472,7 @@ def test_frame_part_mass_is_required_and_positive(robot):
 def test_several_mistakes_are_reported_together(robot):
     robot["motor_drives"]["drive0"]["str_lim"] = 4.0
     robot["motor_drives"]["drive1"]["r_wheel"] = -0.2
-    robot["motor_drives"]["drive2"]["colour"] = "red"
+    robot["motor_drives"]["drive2"]["str_sim_vel"] = 4.0
     robot["motor_drives"]["drive3"]["node"] = 1
     robot["batteries"] = {"bat0": {"type": 3, "id": 1}}
     with pytest.raises(ConfigError) as info:
@@ -422,7 +481,7 @@ def test_several_mistakes_are_reported_together(robot):
     assert paths == [
         "motor_drives.drive0.str_lim",
         "motor_drives.drive1.r_wheel",
-        "motor_drives.drive2.colour",
+        "motor_drives.drive2.str_sim_vel",
         "batteries.bat0.type",
         "motor_drives.drive3.node",
     ]

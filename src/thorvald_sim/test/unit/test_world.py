@@ -245,7 +245,8 @@ def test_unknown_keys_get_a_did_you_mean():
 def test_a_gap_in_the_numbering_is_a_problem():
     patch = {"x": 0, "y": 0, "size_x": 1, "size_y": 1, "lateral_friction": 0.5}
     found, _ = problems_of({"patches": {"patch0": patch, "patch2": patch}})
-    assert "without gaps (patch2 is there)" in found["patches.patch1"].rule
+    assert "without gaps" in found["patches.patch1"].rule
+    assert "at the missing patch1, and patch2 would be dropped" in found["patches.patch1"].rule
     found, _ = problems_of({"patches": {"gravel0": patch}})
     assert found["patches.gravel0"].rule == "entries must be named patch0, patch1, ..."
 
