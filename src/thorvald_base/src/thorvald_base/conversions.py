@@ -28,8 +28,8 @@ from thorvald_msgs.msg import (
 )
 
 from .bases import BatteryInfo, ControllerInfo, Frame, IoInfo, MeasuredDrive
-from .bases.handle import BATTERY_LOST
 from .kinematics import DriveCommand, OdometryResult
+from .modes import BATTERY_LOST
 
 
 def yaw_quaternion(yaw: float) -> Quaternion:

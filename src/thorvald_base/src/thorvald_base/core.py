@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass, field
 from typing import List, Optional, Sequence, Tuple
 
-from thorvald_model.config import RobotConfig
+from thorvald_model.config import RUNTIME_DRIVE_KEYS, RobotConfig
 
 from .bases import BaseHandle, MeasuredDrive
 from .errors import ParameterError
@@ -20,23 +20,6 @@ from .kinematics import BaseCalculator, DriveCommand, DriveLayer, OdometryResult
 
 # A command is absurd, and refused, beyond this multiple of what the fastest wheel can do.
 ABSURD_FACTOR = 10.0
-
-# Keys of motor_drives/driveN that set_drive_params may change at run time: geometry and motor
-# parameters. type, node and names define the hardware and need a restart.
-RUNTIME_DRIVE_KEYS = (
-    "x",
-    "y",
-    "r_wheel",
-    "w_wheel",
-    "prp_gr_rt",
-    "prp_enc_ppr",
-    "prp_max_rpm",
-    "prp_sim_a",
-    "str_gr_rt",
-    "str_enc_ppr",
-    "str_lim",
-    "str_sim_v",
-)
 
 # The original's twist covariance: 0.001 on the diagonal, 0.03 for the yaw rate (row-major 6 x 6).
 DEFAULT_TWIST_COVARIANCE = tuple((0.03 if i == 5 else 0.001) if i == j else 0.0 for i in range(6) for j in range(6))

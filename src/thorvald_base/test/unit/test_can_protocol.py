@@ -217,7 +217,9 @@ def test_a_robots_dbc_has_every_device_at_its_own_id(tmp_path):
     db = cantools.database.load_string(text)
     nodes = sorted({d.node for d in config.drives})
     batteries = [b.id for b in config.batteries if b.type == 1 and b.with_battery]
-    assert len(db.messages) == 9 * len(nodes) + 3 * len(batteries)
+    # the file has no io section: the main IO board (id 0) is on the bus all the same, 2 messages
+    assert len(db.messages) == 9 * len(nodes) + 3 * len(batteries) + 2
+    assert db.get_message_by_frame_id(pr.IO_STATE + 0).name.endswith("io0")
     for n in nodes:
         m = db.get_message_by_frame_id(pr.TX_PDO1 + n)
         assert m.name == f"Roboteq_TxPDO1_node{n}"

@@ -22,6 +22,20 @@ def robot(name):
     return load_robot_config(next(p for p in EXAMPLE_ROBOTS if p.endswith(name + ".yaml")))
 
 
+def test_the_core_modes_are_the_messages_modes():
+    """thorvald_base.modes holds the message constants for the pure core: the same numbers."""
+    from thorvald_base import modes  # noqa: PLC0415
+    from thorvald_msgs.msg import BaseState, BatteryData  # noqa: PLC0415
+
+    for name in ("DRIVE", "HOME", "DECOUPLED", "ONLINE", "LOST_CONNECTION", "PRE_INITIATION"):
+        assert getattr(modes, "MODE_" + name) == getattr(BaseState, "MODE_" + name), name
+    assert (modes.BATTERY_OK, modes.BATTERY_ALARM, modes.BATTERY_LOST) == (
+        BatteryData.STATE_OK,
+        BatteryData.STATE_ALARM,
+        BatteryData.STATE_LOST_CONNECTION,
+    )
+
+
 def test_joint_commands_carry_steering_limit_and_channel():
     diff = robot("thorvald_ii_2wd_diff")
     msg = conversions.command_msg(

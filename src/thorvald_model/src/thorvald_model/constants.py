@@ -14,3 +14,8 @@ DRIVE_DIFF = 1
 
 IO_MAIN_BOARD = 0
 """IO board type 0: the main enclosure PCB (1: sister enclosure PCB, 2: UV lamp board)."""
+
+BATTERY_EMPTY = 0
+"""Battery type 0: an empty battery enclosure."""
+BATTERY_KC = 1
+"""Battery type 1: a KC Electronics battery on the CAN bus."""

@@ -65,9 +65,10 @@ def _is_robot_config_arg(path: str) -> bool:
 
 
 def _robot_dict(load: Callable[[], Any]) -> Dict[str, Any]:
-    """The canonical dict of a robot configuration, or its ConfigError carried out of xacro."""
+    """The canonical dict of a robot configuration with its derived facts (description_dict), or
+    its ConfigError carried out of xacro."""
     try:
-        return load().to_dict()
+        return load().description_dict()
     except ConfigError as e:
         raise RobotConfigAbort(e) from None
 

@@ -9,7 +9,7 @@ which rolls along its yaw) cannot slide sideways, so the robot's centre of rotat
 that wheel's axle line. Two such wheels on different axle lines leave the robot able to turn only
 by sliding, which no calculator can command; that is a layout error, not a calculator choice.
 
-Functions take the drives (``Drive``: ``name``, ``type``, ``x``, ``y``) and passive wheels
+Functions take the drives (``Drive``: ``name``, ``steerable``, ``x``, ``y``) and passive wheels
 (``PassiveWheel``: ``name``, ``fixed``, ``x``, ``y``, ``yaw``) of a configuration, so they serve a
 whole file and a calculator handed its drives alike. Calculators from other packages are only
 known to base_driver's plugin loader: their names get the common-axle rule alone here.
@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass
 from typing import List, Optional, Sequence, Tuple
 
-from .constants import DIFF_CALCULATOR, DRIVE_DIFF, ONE_WHEEL_CALCULATOR, STD_CALCULATOR
+from .constants import DIFF_CALCULATOR, ONE_WHEEL_CALCULATOR, STD_CALCULATOR
 from .errors import Problem
 
 LINE_TOLERANCE = 1e-3  # [m] and [rad]: how far two axle lines may differ and still be one line
@@ -67,7 +67,7 @@ def axle_lines(drives: Sequence, passive_wheels: Sequence = ()) -> List[AxleLine
     """Axle lines of every wheel that cannot steer: type-1 drives, then fixed passive wheels."""
     lines = []
     for d in drives:
-        if d.type == DRIVE_DIFF:
+        if not d.steerable:
             lines.append(AxleLine("motor_drives." + d.name, d.x, d.y, 0.0, 1.0))
     for w in passive_wheels:
         if w.fixed:
@@ -97,7 +97,7 @@ def layout_problems(calculator: str, drives: Sequence, passive_wheels: Sequence 
     axle, problems = common_axle(drives, passive_wheels)
     if problems:
         return problems
-    steered = [d for d in drives if d.type != DRIVE_DIFF]
+    steered = [d for d in drives if d.steerable]
     path = "base_calculator"
     if calculator == STD_CALCULATOR:
         if axle is None and len(steered) < 2:
@@ -111,7 +111,7 @@ def layout_problems(calculator: str, drives: Sequence, passive_wheels: Sequence 
                 )
             )
     elif calculator == DIFF_CALCULATOR:
-        diff = [d for d in drives if d.type == DRIVE_DIFF]
+        diff = [d for d in drives if not d.steerable]
         if len(drives) != 2 or len(diff) != 2:
             problems.append(
                 Problem(

@@ -10,7 +10,7 @@ in one :class:`ConfigError`. Pure Python (PyYAML only).
 import difflib
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields
 from typing import Any, Callable, Iterable, List, Mapping, Optional, Sequence, Tuple
 
 import yaml
@@ -31,6 +31,25 @@ class Key:
     rule: str = ""
     aliases: Tuple[str, ...] = ()
     attr: Optional[str] = None  # dataclass field, when it differs from name
+    runtime: bool = False  # may change while the robot runs (base_driver's set_drive_params)
+
+
+_KEY = "thorvald_key"
+
+
+def key(default: Any = REQUIRED, check=None, rule: str = "", aliases: Tuple[str, ...] = (), runtime: bool = False):
+    """A field of a value type that is a key of the file: its default, rule and aliases are the
+    field's metadata, so the schema is read off the type (:func:`keys_of`) and a new key is one line.
+
+    The default lives in the schema only: the dataclass still takes every value when it is built.
+    """
+    spec = dict(default=default, check=check, rule=rule, aliases=tuple(aliases), runtime=runtime)
+    return field(metadata={_KEY: spec})
+
+
+def keys_of(cls: type) -> Tuple[Key, ...]:
+    """The keys of a value type made with :func:`key`, in field order; the field's type is the key's."""
+    return tuple(Key(f.name, f.type, **f.metadata[_KEY]) for f in fields(cls) if _KEY in f.metadata)
 
 
 def positive(v):

@@ -32,7 +32,7 @@ class DriveJoints:
     """One drive of the simulator block: the joints base_state's entry of index ``index`` moves."""
 
     index: int
-    steerable: bool  # type 0; a type-1 drive's steering joint is fixed
+    steerable: bool  # the generator's steerable="true" (type 0); a type-1 drive's steering joint is fixed
     steering_joint: str
     wheel_joint: str
     wheel_radius: float  # [m]
@@ -125,7 +125,7 @@ def parse_description(xml: str) -> RobotDescription:
             raise DescriptionError(f"the simulator block's drives are not in order: drive {index} comes {k}th")
         drive = DriveJoints(
             index,
-            e.get("type", "0") == "0",
+            e.get("steerable") == "true",  # the loader's answer, written by the generator
             e.get("steering_joint", ""),
             e.get("wheel_joint", ""),
             _float(e.get("wheel_radius"), f"drive {index} wheel_radius"),

@@ -3,7 +3,8 @@
 from typing import List
 
 from ..kinematics import DriveCommand, SimulatedDrive
-from .handle import MODE_ONLINE, BaseHandle, BatteryInfo, ControllerInfo, MeasuredDrive
+from ..modes import MODE_ONLINE
+from .handle import BaseHandle, BatteryInfo, ControllerInfo, MeasuredDrive
 
 
 class SimulatedBase(BaseHandle):
@@ -46,28 +47,29 @@ class SimulatedBase(BaseHandle):
     def batteries(self, time):
         return [
             BatteryInfo(b.id, 0, 100.0, 100.0, self.NOMINAL_VOLTAGE, 0.0, temperatures=(20.0,))
-            for b in self.config.batteries
-            if b.type == 1 and b.with_battery
+            for b in self.config.present_batteries
         ]
 
     def controllers(self, time):
         # One controller per type-0 drive (propulsion + steering channels) and one per pair of
         # type-1 drives (two propulsion channels), as on the robot; channels in the drives' order.
-        channels, first = {}, {}
-        for d, m in zip(self.config.drives, self._measured):
-            first.setdefault(d.node, d)
-            channels.setdefault(d.node, []).append(("propulsion", m.speed, m.wheel_angle, 0.0, 0.0))
-            if d.steerable:
-                channels[d.node].append(("steering", m.steering_speed, m.steering, 0.0, 0.0))
-        return [
-            ControllerInfo(
-                name=d.name,
-                type="simulated " + ("prop/steer" if d.steerable else "prop/prop"),
-                version="simple_sim",
-                can_id=node,
-                mode=MODE_ONLINE,
-                battery_volts=self.NOMINAL_VOLTAGE,
-                motor_vars=tuple(channels[node]),
+        out = []
+        for c in self.config.motor_controllers:
+            motor_vars = []
+            for k in c.indices:
+                m = self._measured[k]
+                motor_vars.append(("propulsion", m.speed, m.wheel_angle, 0.0, 0.0))
+                if c.steered:
+                    motor_vars.append(("steering", m.steering_speed, m.steering, 0.0, 0.0))
+            out.append(
+                ControllerInfo(
+                    name=c.name,
+                    type="simulated " + ("prop/steer" if c.steered else "prop/prop"),
+                    version="simple_sim",
+                    can_id=c.node,
+                    mode=MODE_ONLINE,
+                    battery_volts=self.NOMINAL_VOLTAGE,
+                    motor_vars=tuple(motor_vars),
+                )
             )
-            for node, d in first.items()
-        ]
+        return out

@@ -17,11 +17,11 @@ _VALUES = re.compile(r"^VAL_ (\d+) (.*)$")
 
 def devices_of(config) -> Dict[str, List[Tuple[int, str]]]:
     """Message name prefix -> (id offset, name suffix) per device of the robot."""
-    nodes = sorted({d.node for d in config.drives})
+    nodes = sorted(c.node for c in config.motor_controllers)
     return {
         "Roboteq_": [(n, f"node{n}") for n in nodes],
-        "Battery_": [(b.id, f"bat{b.id}") for b in config.batteries if b.type == 1 and b.with_battery],
-        "IO_": [(b.id, f"io{b.id}") for b in config.io],
+        "Battery_": [(b.id, f"bat{b.id}") for b in config.present_batteries],
+        "IO_": [(b.id, f"io{b.id}") for b in config.io_boards_on_bus],
     }
 
 

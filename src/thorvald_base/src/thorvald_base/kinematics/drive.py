@@ -13,8 +13,6 @@ import math
 from dataclasses import dataclass
 from typing import List, Optional, Sequence, Tuple
 
-from thorvald_model.constants import DRIVE_DIFF
-
 from .odometry import normalize_angle
 from .types import DriveCommand, DriveState
 
@@ -102,7 +100,7 @@ class DriveLayer:
         self.max_speeds = [d.max_wheel_speed for d in self.drives]
         self.inverters: List[Optional[SteeringInverter]] = []
         for k, d in enumerate(self.drives):
-            if d.type == DRIVE_DIFF:
+            if not d.steerable:
                 self.inverters.append(None)
                 continue
             inv = SteeringInverter(d.str_lim)
@@ -147,7 +145,7 @@ class SimulatedDrive:
         dv = d.prp_sim_a * dt
         speed = s.speed + max(-dv, min(dv, command.speed - s.speed))
         steering = s.steering
-        if d.type != DRIVE_DIFF:
+        if d.steerable:
             target = max(-d.str_lim, min(d.str_lim, command.steering))
             da = d.str_sim_v * dt
             # Linear in angle, no wrap-around: the steering cannot pass through its stops.

@@ -23,7 +23,6 @@ A twist that breaks the constraint is replaced by a realisable one (the projecti
 import math
 from typing import List, Sequence, Tuple
 
-from thorvald_model.constants import DRIVE_DIFF
 from thorvald_model.layout import axle_lines, common_axle
 
 from ..errors import KinematicsError
@@ -116,7 +115,7 @@ class Layout:
         self.projection_name = check_projection(projection)
         self.x = [float(d.x) for d in self.drives]
         self.y = [float(d.y) for d in self.drives]
-        self.steerable = [d.type != DRIVE_DIFF for d in self.drives]
+        self.steerable = [d.steerable for d in self.drives]
         self.axle, problems = common_axle(self.drives, self.fixed_wheels)
         if problems:
             raise KinematicsError("; ".join(p.rule for p in problems))
