@@ -40,14 +40,13 @@ import threading
 
 import rospy
 import tf2_ros
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import BatteryState, JointState
 from std_srvs.srv import SetBool, SetBoolResponse, Trigger, TriggerResponse
 
 from thorvald_model import ConfigError, load_robot_config, parse_robot_config
-from thorvald_model.frames import normalize_tf_prefix
 from thorvald_msgs.msg import BaseState, BatteryArray, CANFrame, ControllerArray, IOArray
 from thorvald_msgs.srv import (
     CanID,
@@ -59,80 +58,82 @@ from thorvald_msgs.srv import (
 )
 
 from . import conversions
-from .bases import create_base_handle, handle_name
-from .bases.handle import BATTERY_LOST, MODE_LOST_CONNECTION
-from .core import DEFAULT_TWIST_COVARIANCE, BaseDriverCore, PoseCovariance
+from .bases import create_base_handle
+from .bases.handle import DriveTopics, Ports
+from .core import BaseDriverCore, PoseCovariance
+from .diagnostics import LinkWatch, base_statuses
 from .errors import ParameterError, ThorvaldBaseError
+from .params import PARAMETER_NAMES, DriverParams
 from .plugins import load_calculator
 
-NODE_PARAMS = (
-    "robot_model",
-    "simple_sim",
-    "base_handle",
-    "tf_prefix",
-    "enable_odom_tf",
-    "odom_frame_id",
-    "passthrough_gazebo_odometry",
-    "rate",
-    "command_timeout",
-    "twist_covariance",
-    "estimator",
-    "projection",
-    "measured_timeout",
-    "can_interface_type",
-    "can_interface_name",
-    "can_bitrate",
-    "allow_relay_to_base_devices",
-    "joint_states_remap_to",
-)
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
 STATUS_PERIOD = 1.0  # [s] between battery_data / motor_controller_data messages
 EXIT_REFUSED = 1  # exit status when the node refuses to start
 
 
-def load_config(params: dict):
+def load_config(raw: dict, params: DriverParams):
     """The robot configuration: the private namespace's, else the ~robot_model file's."""
-    if any(key not in NODE_PARAMS for key in params):
-        source = params.get("robot_model") or rospy.resolve_name("~") + " parameters"
-        return parse_robot_config(params, source, ignore=NODE_PARAMS), False
-    path = params.get("robot_model")
-    if not path:
+    if any(key not in PARAMETER_NAMES for key in raw):
+        source = params.robot_model or rospy.resolve_name("~") + " parameters"
+        return parse_robot_config(raw, source, ignore=PARAMETER_NAMES), False
+    if not params.robot_model:
         raise ParameterError(
             "~robot_model: <missing>: no robot configuration: give the robot's YAML file as ~robot_model "
             "or load it into the node's private namespace"
         )
-    return load_robot_config(str(path)), True
+    return load_robot_config(params.robot_model), True
 
 
-def number(params: dict, key: str, default: float) -> float:
-    value = params.get(key, default)
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"~{key}: {value!r}: must be a number") from None
+class RosDriveTopics(DriveTopics):
+    """A handle's drive commands and measured states on the node's topics (thorvald_msgs/BaseState)."""
+
+    def __init__(self, command_topic: str, state_topic: str):
+        self.pub = rospy.Publisher(command_topic, BaseState, queue_size=1)
+        self.state_topic = state_topic
+        self.sub = None
+
+    def send(self, commands, time, drives):
+        self.pub.publish(
+            conversions.command_msg(
+                rospy.Time.from_sec(time), commands, [d.max_steering_speed for d in drives], [d.channel for d in drives]
+            )
+        )
+
+    def listen(self, on_states):
+        def on_message(msg):
+            try:
+                on_states(conversions.measured_drives(msg), msg.header.stamp.to_sec())
+            except ValueError as e:
+                rospy.logwarn_throttle(WARN_PERIOD, "base_driver: %s ignored: %s", self.state_topic, e)
+
+        self.sub = rospy.Subscriber(self.state_topic, BaseState, on_message, queue_size=1)
+
+    def close(self):
+        for endpoint in (self.pub, self.sub):
+            if endpoint is not None:
+                endpoint.unregister()
+
+
+class RosPorts(Ports):
+    def drive_topics(self, command_topic, state_topic):
+        return RosDriveTopics(command_topic, state_topic)
 
 
 class BaseDriverNode:
     def __init__(self):
-        params = rospy.get_param("~", {})
-        self.config, from_file = load_config(params)
-        self.tf_prefix = normalize_tf_prefix(params.get("tf_prefix", ""))
-        self.odom_frame = str(params.get("odom_frame_id", "odom"))
-        self.base_frame = self.tf_prefix + "base_link"
-        self.enable_tf = bool(params.get("enable_odom_tf", True))
-        self.rate = number(params, "rate", 50.0)
-        if not self.rate > 0:
-            raise ParameterError(f"~rate: {self.rate!r}: must be > 0 [Hz]")
-        self.covariance = PoseCovariance(params.get("twist_covariance", DEFAULT_TWIST_COVARIANCE))
-        calculator = load_calculator(
-            self.config,
-            estimator=str(params.get("estimator", "lsq")),
-            projection=str(params.get("projection", "axle")),
-        )
-        command_timeout = number(params, "command_timeout", 0.5)
-        handle = create_base_handle(self.config, params)
+        raw = rospy.get_param("~", {})
+        self.params = params = DriverParams.from_dict(raw)
+        self.config, from_file = load_config(raw, params)
+        self.tf_prefix = params.tf_prefix
+        self.odom_frame = params.odom_frame_id
+        self.base_frame = params.base_frame
+        self.enable_tf = params.enable_odom_tf
+        self.rate = params.rate
+        self.covariance = PoseCovariance(params.twist_covariance)
+        calculator = load_calculator(self.config, estimator=params.estimator, projection=params.projection)
+        handle = create_base_handle(self.config, params, RosPorts())
         try:
-            self.core = BaseDriverCore(self.config, calculator, handle, command_timeout=command_timeout)
+            self.core = BaseDriverCore(self.config, calculator, handle, command_timeout=params.command_timeout)
         except ThorvaldBaseError:
             handle.close()
             raise
@@ -151,8 +152,7 @@ class BaseDriverNode:
         self.io_pub = rospy.Publisher("io_data", IOArray, queue_size=1)
         self.battery_state_pubs = {
             b.id: rospy.Publisher("battery_state/" + b.name, BatteryState, queue_size=1)
-            for b in self.config.batteries
-            if b.type == 1 and b.with_battery
+            for b in self.config.present_batteries
         }
         self.diagnostics_pub = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=1)
         self.frames_base_pub = rospy.Publisher("can_frames_base_r", CANFrame, queue_size=200)
@@ -160,7 +160,7 @@ class BaseDriverNode:
         rospy.Subscriber("can_frames_device_t", CANFrame, self.on_device_frame, queue_size=100)
         self.tf = tf2_ros.TransformBroadcaster() if self.enable_tf else None
         self.gazebo_odom = None
-        if params.get("passthrough_gazebo_odometry", False):
+        if params.passthrough_gazebo_odometry:
             rospy.Subscriber("odometry/gazebo", Odometry, self.on_gazebo_odometry, queue_size=10)
         rospy.Subscriber("cmd_vel", Twist, self.on_cmd_vel, queue_size=1)
         rospy.Service("~home_steering", Trigger, self.srv_home_steering)
@@ -180,14 +180,14 @@ class BaseDriverNode:
             for relay in range(2):
                 rospy.Service(f"~setRl{relay + 1}", SetBool, self._relay_service(main.id, relay))
         self._last_status_publish = None
-        self._link_logged = {}
+        self.link_watch = LinkWatch()
         for warning in self.config.warnings:
             rospy.logwarn("base_driver: %s", warning.format(self.config.source))
         rospy.loginfo(
             "base_driver: %d drives, calculator %s, base %s, %.0f Hz, odom tf %s",
             len(self.config.drives),
             self.config.base_calculator,
-            handle_name(params),
+            params.handle,
             self.rate,
             "on" if self.enable_tf else "off",
         )
@@ -343,49 +343,18 @@ class BaseDriverNode:
 
     def publish_diagnostics(self, stamp, controllers, batteries, link):
         """/diagnostics: one status per motor controller and battery, one for the bus."""
-        lost = DiagnosticStatus.ERROR
-        statuses = []
-        ns = rospy.get_namespace().strip("/")
-        prefix = f"base_driver ({ns}): " if ns else "base_driver: "
-        for c in controllers:
-            level = lost if c.mode == MODE_LOST_CONNECTION else DiagnosticStatus.OK
-            flags = [name for name, on in c.status_flags if on]
-            if level == DiagnosticStatus.OK and flags:
-                level = DiagnosticStatus.WARN
-            message = "lost connection" if c.mode == MODE_LOST_CONNECTION else (", ".join(flags) if flags else "ok")
-            values = {"mode": c.mode, "battery volts": f"{c.battery_volts:.1f}", "version": c.version}
-            statuses.append(
-                conversions.diagnostic_status(
-                    f"{prefix}motor controller {c.name}", f"node {c.can_id}", level, message, values
-                )
-            )
-        for b in batteries:
-            level = lost if b.state == BATTERY_LOST else (DiagnosticStatus.WARN if b.alarms else DiagnosticStatus.OK)
-            message = "lost connection" if b.state == BATTERY_LOST else (", ".join(b.alarms) if b.alarms else "ok")
-            values = {"voltage": f"{b.voltage:.2f}", "state of charge": f"{b.state_of_charge:.0f} %"}
-            statuses.append(
-                conversions.diagnostic_status(f"{prefix}battery {b.id}", f"battery {b.id}", level, message, values)
-            )
-        if link:
-            level = DiagnosticStatus.ERROR if "closed" in link.get("bus", "") else DiagnosticStatus.OK
-            if level == DiagnosticStatus.OK and (link.get("wheels stopped: lost") or link.get("wrong script")):
-                level = DiagnosticStatus.ERROR
-            self.log_link_changes(link)
-            statuses.append(conversions.diagnostic_status(f"{prefix}CAN bus", "can", level, link.get("bus", ""), link))
+        for change in self.link_watch.changes(link):
+            rospy.logwarn("base_driver: %s", change)
+        statuses = base_statuses(rospy.get_namespace().strip("/"), controllers, batteries, link)
         if statuses:
-            msg = DiagnosticArray(status=statuses)
+            msg = DiagnosticArray(
+                status=[
+                    conversions.diagnostic_status(st.name, st.hardware_id, st.level, st.message, dict(st.values))
+                    for st in statuses
+                ]
+            )
             msg.header.stamp = stamp
             self.diagnostics_pub.publish(msg)
-
-    def log_link_changes(self, link):
-        """A warning when the hardware link's state changes (a bus error, lost devices, a wrong script)."""
-        for key in ("last error", "wheels stopped: lost", "wrong script"):
-            value = link.get(key)
-            if value and value != self._link_logged.get(key):
-                rospy.logwarn("base_driver: CAN: %s: %s", key, value)
-            if value is None and self._link_logged.get(key) and key == "wheels stopped: lost":
-                rospy.logwarn("base_driver: CAN: every device heard again: the wheels follow commands")
-            self._link_logged[key] = value
 
     def publish_odometry(self, odometry, stamp):
         if not odometry.valid:

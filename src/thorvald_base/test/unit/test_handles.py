@@ -1,15 +1,18 @@
 """The base handle contract (stop before close, homing), the handle factory, and the pose covariance."""
 
+import dataclasses
 import math
 
 import pytest
 from base_test_helpers import four_ws
 
-from thorvald_base.bases import BaseHandle, MeasuredDrive, create_base_handle, handle_name
+from thorvald_base.bases import BaseHandle, MeasuredDrive, create_base_handle
+from thorvald_base.bases.handle import DriveTopics, Ports
 from thorvald_base.bases.simulated import SimulatedBase
 from thorvald_base.core import DEFAULT_TWIST_COVARIANCE, BaseDriverCore, PoseCovariance
 from thorvald_base.errors import ParameterError, ThorvaldBaseError
 from thorvald_base.kinematics import DriveCommand, OdometryResult, PltfClcStd, Pose, Twist
+from thorvald_base.params import DriverParams
 
 
 class RecordingBase(BaseHandle):
@@ -91,18 +94,92 @@ def test_the_simulated_base_stops_its_drives_on_close():
 
 def test_the_factory_picks_the_handle_from_the_parameters():
     config = four_ws()
-    assert handle_name({"simple_sim": True}) == "simple_sim"
-    assert handle_name({"simple_sim": False}) == "can"
-    assert handle_name({"simple_sim": False, "base_handle": "simple_sim"}) == "simple_sim"
-    assert isinstance(create_base_handle(config, {"simple_sim": True}), SimulatedBase)
+    params = DriverParams.from_dict
+    assert params({"simple_sim": True}).handle == "simple_sim"
+    assert params({"simple_sim": False}).handle == "can"
+    assert params({"simple_sim": False, "base_handle": "simple_sim"}).handle == "simple_sim"
+    assert isinstance(create_base_handle(config, params({"simple_sim": True})), SimulatedBase)
     with pytest.raises(
         ParameterError,
         match=r"~base_handle: 'warp': no such base handle; available: can, simple_sim, simulated_joints$",
     ):
-        create_base_handle(config, {"base_handle": "warp"})
+        create_base_handle(config, params({"base_handle": "warp"}))
     # simple_sim false is the CAN base, which needs a python-can interface
     with pytest.raises(ParameterError, match=r"~can_interface_type: empty: name a python-can interface"):
-        create_base_handle(config, {"simple_sim": False})
+        create_base_handle(config, params({"simple_sim": False}))
+
+
+class LoopbackTopics(DriveTopics):
+    """The node's side of simulated_joints, played in the test: what was sent, and the listener."""
+
+    def __init__(self):
+        self.sent, self.listener, self.closed = [], None, False
+
+    def send(self, commands, time, drives):
+        self.sent.append((time, tuple(commands), [d.max_steering_speed for d in drives]))
+
+    def listen(self, on_states):
+        self.listener = on_states
+
+    def close(self):
+        self.closed = True
+
+
+class LoopbackPorts(Ports):
+    def __init__(self):
+        self.topics = {}
+
+    def drive_topics(self, command_topic, state_topic):
+        self.topics[(command_topic, state_topic)] = LoopbackTopics()
+        return self.topics[(command_topic, state_topic)]
+
+
+def test_simulated_joints_trades_on_the_nodes_drive_topics():
+    """The factory wires the handle to the ports the node offers: no ROS import in the handle."""
+    ports = LoopbackPorts()
+    params = DriverParams.from_dict({"base_handle": "simulated_joints", "measured_timeout": 0.25})
+    base = create_base_handle(four_ws(), params, ports)
+    (topics,) = ports.topics.values()
+    assert list(ports.topics) == [("drive_commands", "drive_states")]
+    assert base.stale_after == 0.25
+    topics.listener([MeasuredDrive(0.2, 0.3, 1.0, 0.0)] * 4, 5.0)
+    base.send_drive_commands([DriveCommand(0.2, 0.4)] * 4, 5.1)
+    assert topics.sent[-1] == (5.1, tuple([DriveCommand(0.2, 0.4)] * 4), [4.0] * 4)
+    assert base.read_drive_states(5.1)[0].speed == 0.3
+    base.close(5.2)
+    assert topics.closed
+    with pytest.raises(ParameterError, match="needs base_driver's topics"):
+        create_base_handle(four_ws(), params)
+
+
+@pytest.mark.parametrize(
+    "raw, message",
+    [
+        ({"rate": 0}, r"~rate: 0: must be > 0 \[Hz\]"),
+        ({"rate": "fast"}, r"~rate: 'fast': must be a number"),
+        ({"measured_timeout": -1.0}, r"~measured_timeout: -1.0: must be > 0 \[s\]"),
+        ({"enable_odom_tf": "maybe"}, r"~enable_odom_tf: 'maybe': must be true or false"),
+        ({"command_timeout": [1]}, r"~command_timeout: \[1\]: must be a number"),
+    ],
+)
+def test_driver_parameters_refuse_bad_values_by_name(raw, message):
+    with pytest.raises(ParameterError, match=message):
+        DriverParams.from_dict(raw)
+
+
+def test_driver_parameters_read_once_with_the_originals_defaults():
+    p = DriverParams.from_dict({"tf_prefix": "thorvald_001", "enable_odom_tf": "false", "motor_drives": {}})
+    assert (p.tf_prefix, p.base_frame, p.enable_odom_tf) == ("thorvald_001/", "thorvald_001/base_link", False)
+    default = DriverParams.from_dict({})
+    assert (default.rate, default.command_timeout, default.odom_frame_id, default.enable_odom_tf) == (
+        50.0,
+        0.5,
+        "odom",
+        True,
+    )
+    assert default.twist_covariance == DEFAULT_TWIST_COVARIANCE and default.can_bitrate == 1000000
+    with pytest.raises(dataclasses.FrozenInstanceError):  # read once, the same value everywhere
+        default.rate = 10.0
 
 
 def odometry(vx, dt):

@@ -32,6 +32,12 @@ NOT_PURE = {
     "thorvald_sim.robot": "the simulator's physics (pybullet)",
     "thorvald_sim.simulation": "the simulator's physics (pybullet)",
 }
+# Modules that import ROS only when a function runs, on purpose; every other module (the base
+# handles among them) imports none even inside a function.
+CALL_TIME_ROS = {
+    "thorvald_sim.can_emulator_node": "the emulator runs without ROS too; with a master it offers services",
+    "thorvald_bringup.odometry_report_cli": "a command that reads the recorded bag (genpy) after the drive",
+}
 FORBIDDEN = ["rospy", "genpy", "pybullet", "thorvald_msgs", "geometry_msgs", "nav_msgs", "sensor_msgs", "tf2_ros"]
 
 # Imports each module in a fresh interpreter and prints which forbidden top-level modules it pulled in.
@@ -86,3 +92,52 @@ def test_the_plugin_loader_searches_the_workspace():
     from thorvald_base.plugins import CalculatorLoader  # noqa: PLC0415
 
     assert "pltf_clc_std::PltfClcStd" in CalculatorLoader().known_names()
+
+
+def _imports_anywhere(path, module):
+    """Every module an import statement of the file names, at any depth (inside functions too),
+    relative imports resolved against the module's package."""
+    import ast  # noqa: PLC0415
+
+    with open(path) as f:
+        tree = ast.parse(f.read(), path)
+    package = module if path.endswith("__init__.py") else module.rpartition(".")[0]
+    names = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names += [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".")
+                anchor = ".".join(parts[: len(parts) - node.level + 1])
+                base = f"{anchor}.{base}" if base else anchor
+            names += [base] + [f"{base}.{a.name}" for a in node.names]
+    return names
+
+
+def test_no_pure_module_imports_the_ros_runtime_even_inside_a_function():
+    """An import inside a function escapes the import-time check above: the source is read instead.
+    Importing a module of NOT_PURE (e.g. conversions) counts as importing what it imports; the
+    modules of CALL_TIME_ROS, and only they, do it on purpose."""
+    import importlib  # noqa: PLC0415
+    import pkgutil  # noqa: PLC0415
+
+    offenders = {}
+    checked = 0
+    for name in PACKAGES:
+        pkg = importlib.import_module(name)
+        modules = [(name, pkg.__file__)]
+        for info in pkgutil.walk_packages(pkg.__path__, name + "."):
+            spec = importlib.util.find_spec(info.name)
+            modules.append((info.name, spec.origin))
+        for module, path in modules:
+            if module in NOT_PURE or not path or not path.endswith(".py"):
+                continue
+            checked += 1
+            bad = sorted({n for n in _imports_anywhere(path, module) if n.split(".")[0] in FORBIDDEN or n in NOT_PURE})
+            if bad:
+                offenders[module] = bad
+    assert checked > 40
+    assert sorted(offenders) == sorted(CALL_TIME_ROS), {m: b for m, b in offenders.items() if m not in CALL_TIME_ROS}
+    assert not any(m.startswith("thorvald_base.bases") for m in CALL_TIME_ROS)

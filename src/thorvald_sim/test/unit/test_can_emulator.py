@@ -19,6 +19,7 @@ from thorvald_base.bases.handle import Frame
 from thorvald_base.core import BaseDriverCore
 from thorvald_base.errors import ParameterError, ThorvaldBaseError
 from thorvald_base.kinematics import DriveCommand
+from thorvald_base.params import DriverParams
 from thorvald_base.plugins import load_calculator
 from thorvald_model import load_robot_config, parse_robot_config
 from thorvald_sim.can_emulator import CanEmulator
@@ -230,7 +231,10 @@ def test_io_boards_get_their_initial_relay_states():
 )
 def test_buses_that_cannot_open_give_one_line(interface, channel, message):
     with pytest.raises((ParameterError, ThorvaldBaseError), match=message) as info:
-        CanBase.from_params(load_robot_config(STD), {"can_interface_type": interface, "can_interface_name": channel})
+        CanBase.from_params(
+            load_robot_config(STD),
+            DriverParams.from_dict({"can_interface_type": interface, "can_interface_name": channel}),
+        )
     assert "\n" not in str(info.value)
 
 

@@ -3,7 +3,9 @@
 The registry maps a handle name (base_driver's ``~base_handle``) to ``module:Class``, imported only
 when that handle is created (as python-can's interface registry). ``~base_handle`` defaults to
 ``simple_sim`` when ``~simple_sim`` is true; with ``simple_sim`` false it names the CAN base,
-``can``, which a later release registers.
+``can``. A handle gets base_driver's parameters as one frozen value
+(:class:`~thorvald_base.params.DriverParams`), never the raw namespace, and imports no ROS module:
+one that trades messages gets them through the node's :class:`~thorvald_base.bases.handle.Ports`.
 
 ====================  =======================================================================
 name                  handle
@@ -32,30 +34,24 @@ BASE_HANDLES: Dict[str, str] = {
 }
 
 
-def handle_name(params: dict) -> str:
-    """The handle base_driver's private parameters ask for."""
-    name = params.get("base_handle")
-    if name:
-        return str(name)
-    return "simple_sim" if params.get("simple_sim", False) else "can"
-
-
 def known_handles() -> List[str]:
     return sorted(BASE_HANDLES)
 
 
-def create_base_handle(config, params: dict) -> BaseHandle:
-    """The base handle named by ``params`` (base_driver's private parameters) for this robot."""
-    name = handle_name(params)
+def create_base_handle(config, params, ports=None) -> BaseHandle:
+    """The base handle ``params`` (base_driver's :class:`~thorvald_base.params.DriverParams`) asks
+    for, for this robot; ``ports`` is what the node offers handles that talk over topics
+    (:class:`~thorvald_base.bases.handle.Ports`)."""
+    name = params.handle
     target = BASE_HANDLES.get(name)
     if target is None:
-        origin = "" if params.get("base_handle") else f" (simple_sim {bool(params.get('simple_sim', False))})"
+        origin = "" if params.base_handle else f" (simple_sim {params.simple_sim})"
         raise ParameterError(
             f"~base_handle: {name!r}{origin}: no such base handle; available: {', '.join(known_handles())}"
         )
     module_name, _, class_name = target.partition(":")
     cls = getattr(importlib.import_module(module_name), class_name)
-    return cls.from_params(config, params)
+    return cls.from_params(config, params, ports)
 
 
 __all__ = [
@@ -67,6 +63,5 @@ __all__ = [
     "IoInfo",
     "MeasuredDrive",
     "create_base_handle",
-    "handle_name",
     "known_handles",
 ]

@@ -23,27 +23,14 @@ from ..can import protocol as pr
 from ..can.devices import Battery, IoBoard, MotorController
 from ..errors import ParameterError, ThorvaldBaseError
 from ..kinematics import DriveCommand
-from .handle import (
-    BATTERY_ALARM,
-    BATTERY_LOST,
-    BATTERY_OK,
-    MODE_DRIVE,
-    MODE_HOME,
-    MODE_LOST_CONNECTION,
-    MODE_ONLINE,
-    BaseHandle,
-    BatteryInfo,
-    ControllerInfo,
-    Frame,
-    IoInfo,
-    MeasuredDrive,
-)
+from ..modes import BATTERY_ALARM, BATTERY_LOST, BATTERY_OK, MODE_DRIVE, MODE_HOME, MODE_LOST_CONNECTION, MODE_ONLINE
+from ..params import DEFAULT_BITRATE
+from .handle import BaseHandle, BatteryInfo, ControllerInfo, Frame, IoInfo, MeasuredDrive
 
 # The original's enclosure-PCB USB bridges: their serial protocol was never published.
 UNPUBLISHED_INTERFACES = ("enc_pcb_v1rev6", "enc_pcb_v2rev1")
 RELAY_QUEUE_LIMIT = 100  # frames relayed per cycle; the original dropped its queue past 100
 READ_LIMIT = 2000  # frames read per cycle at most (a flooded bus cannot stall the loop)
-DEFAULT_BITRATE = 1000000
 REOPEN_PERIOD = 1.0  # [s] of wall time between attempts to reopen a failed bus
 
 
@@ -101,16 +88,8 @@ class CanBase(BaseHandle):
         self._reopen = reopen  # () -> a new bus, after bus errors
         self._next_reopen = 0.0  # [s] monotonic
         self.counters = BusCounters()
-        self.controllers_: List[MotorController] = []
-        by_node: Dict[int, List[int]] = {}
-        for k, d in enumerate(config.drives):
-            by_node.setdefault(d.node, []).append(k)
-        for node, indices in by_node.items():
-            drives = sorted((config.drives[k] for k in indices), key=lambda d: d.channel)
-            self.controllers_.append(
-                MotorController(node, drives, sorted(indices, key=lambda k: config.drives[k].channel))
-            )
-        self.batteries_ = [Battery(b) for b in config.batteries if b.type == 1 and b.with_battery]
+        self.controllers_ = [MotorController(c.node, c.drives, c.indices) for c in config.motor_controllers]
+        self.batteries_ = [Battery(b) for b in config.present_batteries]
         self.ios = [IoBoard(b) for b in self.io_config]
         try:
             self.owned = pr.device_ids(
@@ -137,14 +116,12 @@ class CanBase(BaseHandle):
         return self.config.io_boards_on_bus
 
     @classmethod
-    def from_params(cls, config, params):
-        interface = str(params.get("can_interface_type", "") or "")
-        channel = str(params.get("can_interface_name", "") or "")
-        bitrate = int(params.get("can_bitrate", DEFAULT_BITRATE))
+    def from_params(cls, config, params, ports=None):
+        interface, channel, bitrate = params.can_interface_type, params.can_interface_name, params.can_bitrate
         handle = cls(
             config, open_bus(interface, channel, bitrate), reopen=lambda: open_bus(interface, channel, bitrate)
         )
-        handle.allow_relay_to_base = bool(params.get("allow_relay_to_base_devices", False))
+        handle.allow_relay_to_base = params.allow_relay_to_base_devices
         return handle
 
     # ---- the cycle -------------------------------------------------------------------------------

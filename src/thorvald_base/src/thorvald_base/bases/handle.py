@@ -9,23 +9,12 @@ Times are seconds on whichever clock the node uses (ROS time, simulated time in 
 """
 
 from dataclasses import dataclass
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 from thorvald_model.config import RobotConfig
 
 from ..errors import ThorvaldBaseError
 from ..kinematics import DriveCommand, DriveState
-
-# Modes of Controller.controller_mode, the MODE_* values of thorvald_msgs/BaseState.
-MODE_DRIVE = 0
-MODE_HOME = 1
-MODE_ONLINE = 3
-MODE_LOST_CONNECTION = 4
-
-# BatteryInfo.state, as battery_data reports it.
-BATTERY_OK = 0
-BATTERY_ALARM = 1
-BATTERY_LOST = 2
 
 
 @dataclass(frozen=True)
@@ -89,6 +78,33 @@ class IoInfo:
     online: bool
 
 
+class DriveTopics:
+    """Drive commands out and measured drive states in, over the node's topics (a simulator's).
+
+    The node makes it (base_driver_node.RosPorts); a handle only calls it, so no handle imports
+    rospy or a message type.
+    """
+
+    def send(self, commands: Sequence[DriveCommand], time: float, drives: Sequence) -> None:
+        """One command per drive for time [s]; drives: the configuration's, for their steering
+        speed limits and channels as they are now (set_drive_params may change them)."""
+        raise NotImplementedError
+
+    def listen(self, on_states: Callable[[List["MeasuredDrive"], float], None]) -> None:
+        """on_states(states in drive order, their time [s]) for each measurement that arrives."""
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Stops both."""
+
+
+class Ports:
+    """What base_driver's node offers a handle besides the configuration and parameters."""
+
+    def drive_topics(self, command_topic: str, state_topic: str) -> DriveTopics:
+        raise NotImplementedError
+
+
 @dataclass
 class Frame:
     """A CAN frame, independent of python-can and of ROS messages (the relay for implements)."""
@@ -121,11 +137,12 @@ class BaseHandle:
         self._last_time: Optional[float] = None
 
     @classmethod
-    def from_params(cls, config: RobotConfig, params: dict) -> "BaseHandle":
-        """The handle for base_driver's private parameters (the factory's entry point).
+    def from_params(cls, config: RobotConfig, params, ports: Optional["Ports"] = None) -> "BaseHandle":
+        """The handle for base_driver's parameters (DriverParams; the factory's entry point).
 
         A handle that needs more than the configuration (a CAN bus opened from
-        ``can_interface_type``) reads it here, so that tests can construct it directly.
+        ``can_interface_type``, the node's topics) takes it here, so that tests can construct
+        it directly.
         """
         return cls(config)
 

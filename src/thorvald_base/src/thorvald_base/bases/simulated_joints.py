@@ -8,7 +8,8 @@ slip. The simulator knows nothing of base_driver beyond these two topics (thorva
 ``drive_commands`` when a robot is spawned with ``-command_topic drive_commands``).
 
 The class is pure: it gets a function that sends commands, and the node's subscriber hands it the
-measured states (:meth:`update`). Only :meth:`from_params` talks to ROS, to wire them.
+measured states (:meth:`update`); :meth:`from_params` wires both to the topics the node offers
+(:class:`~thorvald_base.bases.handle.Ports`), so no ROS module is imported here.
 
 Homing points every wheel straight with zero speed until base_driver ends it. Measurements older
 than ``stale_after`` [s] mean the simulator lost the robot: the wheels are sent zero speeds and the
@@ -20,7 +21,8 @@ from typing import Callable, List, Optional, Sequence, Tuple
 
 from ..errors import ParameterError
 from ..kinematics import DriveCommand
-from .handle import MODE_LOST_CONNECTION, MODE_ONLINE, BaseHandle, ControllerInfo, MeasuredDrive
+from ..modes import MODE_LOST_CONNECTION, MODE_ONLINE
+from .handle import BaseHandle, ControllerInfo, MeasuredDrive
 
 SendCommands = Callable[[Tuple[DriveCommand, ...], float], None]
 
@@ -36,40 +38,20 @@ class SimulatedJointsBase(BaseHandle):
         self._lock = threading.Lock()
         self._measured: List[MeasuredDrive] = [MeasuredDrive(0.0, 0.0, 0.0, 0.0) for _ in config.drives]
         self._measured_time: Optional[float] = None
-        self._ros = ()
+        self._topics = None
 
     @classmethod
-    def from_params(cls, config, params: dict) -> "SimulatedJointsBase":
-        import rospy  # noqa: PLC0415  (the node's side: only when base_driver creates this handle)
-
-        from thorvald_msgs.msg import BaseState  # noqa: PLC0415
-
-        from .. import conversions  # noqa: PLC0415
-
-        stale_after = float(params.get("measured_timeout", 0.5))
-        if not stale_after > 0:
-            raise ParameterError(f"~measured_timeout: {stale_after!r}: must be > 0 [s]")
-        pub = rospy.Publisher(cls.COMMAND_TOPIC, BaseState, queue_size=1)
-
-        def send(commands, time):
-            drives = handle.config.drives
-            pub.publish(
-                conversions.command_msg(
-                    rospy.Time.from_sec(time),
-                    commands,
-                    [d.max_steering_speed for d in drives],
-                    [d.channel for d in drives],
-                )
-            )
-
-        def on_states(msg):
-            try:
-                handle.update(conversions.measured_drives(msg), msg.header.stamp.to_sec())
-            except ValueError as e:
-                rospy.logwarn_throttle(5.0, "base_driver: drive_states ignored: %s", e)
-
-        handle = cls(config, send, stale_after)
-        handle._ros = (pub, rospy.Subscriber(cls.STATE_TOPIC, BaseState, on_states, queue_size=1))
+    def from_params(cls, config, params, ports=None) -> "SimulatedJointsBase":
+        """Wired to the simulator through the node's drive topics (``drive_commands`` out,
+        ``drive_states`` in); ``params.measured_timeout`` [s] is when measurements are stale."""
+        if ports is None:
+            raise ParameterError("~base_handle: 'simulated_joints': needs base_driver's topics (run it in the node)")
+        topics = ports.drive_topics(cls.COMMAND_TOPIC, cls.STATE_TOPIC)
+        handle = cls(
+            config, lambda commands, time: topics.send(commands, time, handle.config.drives), params.measured_timeout
+        )
+        topics.listen(handle.update)
+        handle._topics = topics
         return handle
 
     def update(self, states: Sequence[MeasuredDrive], time: float) -> None:
@@ -104,14 +86,11 @@ class SimulatedJointsBase(BaseHandle):
 
     def controllers(self, time):
         mode = MODE_ONLINE if self.online(time) else MODE_LOST_CONNECTION
-        seen = {}
-        for d in self.config.drives:
-            seen.setdefault(d.node, d)
         return [
-            ControllerInfo(name=d.name, type="simulated joints", version="thorvald_sim", can_id=node, mode=mode)
-            for node, d in seen.items()
+            ControllerInfo(name=c.name, type="simulated joints", version="thorvald_sim", can_id=c.node, mode=mode)
+            for c in self.config.motor_controllers
         ]
 
     def _close(self):
-        for endpoint in self._ros:
-            endpoint.unregister()
+        if self._topics is not None:
+            self._topics.close()
