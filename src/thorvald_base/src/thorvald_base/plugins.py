@@ -29,6 +29,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Dict, List, Optional
 
+from thorvald_model.errors import ConfigError, Problem
+
 from .errors import PluginDescriptionError, PluginError, PluginImportError, PluginNotFoundError, PluginTypeError
 from .kinematics.calculator import BaseCalculator
 
@@ -173,7 +175,25 @@ class CalculatorLoader:
 
 
 def load_calculator(config, rospack=None, **options) -> BaseCalculator:
-    """The robot configuration's base_calculator, created and initialised with its drives."""
+    """The robot configuration's base_calculator, created and initialised with its drives.
+
+    A layout the calculator declares it cannot serve (its ``layout_rules``) is a ConfigError of
+    the robot file, worded as the loader words its own problems (file, key path, value, rule).
+    """
     calc = CalculatorLoader(rospack).create(config.base_calculator, **options)
+    problems = calc.layout_problems(config.drives, config.passive_wheels)
+    if problems:
+        raise ConfigError(config.source, problems)
     calc.initialize(config.drives, config.passive_wheels)
     return calc
+
+
+def calculator_layout_problems(config, rospack=None) -> List[Problem]:
+    """The problems of the configuration's layout for its calculator (its own rules, the shared
+    ones having passed the loader); an unknown or unloadable calculator is a problem of
+    ``base_calculator`` itself."""
+    try:
+        cls = CalculatorLoader(rospack).class_for(config.base_calculator)
+    except PluginError as e:
+        return [Problem("base_calculator", config.base_calculator, str(e))]
+    return cls.layout_problems(config.drives, config.passive_wheels)

@@ -81,6 +81,16 @@ def format_details(config: RobotConfig) -> str:
     return "\n".join(lines)
 
 
+def calculator_problems(config: RobotConfig) -> list:
+    """The layout rules the robot's calculator declares (its plugin, found as base_driver finds it),
+    beyond the rules every calculator shares, which the loader checked."""
+    try:
+        from thorvald_base.plugins import calculator_layout_problems  # noqa: PLC0415  (the plugins' package)
+    except ImportError:  # thorvald_model alone: the shared rules are all there is to check
+        return []
+    return calculator_layout_problems(config)
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     parser = argparse.ArgumentParser(
         prog="check_config", description="Validate Thorvald robot configuration files and summarise the robots."
@@ -92,7 +102,11 @@ def main(argv: Optional[List[str]] = None) -> int:
     configs, failed = [], 0
     for path in args.files:
         try:
-            configs.append(load_robot_config(path))
+            config = load_robot_config(path)
+            problems = calculator_problems(config)
+            if problems:
+                raise ConfigError(path, problems)
+            configs.append(config)
         except ConfigError as e:
             failed += 1
             print(e, file=sys.stderr)

@@ -1,8 +1,9 @@
-"""Which wheel layouts a robot may have, and which each built-in kinematics calculator can serve.
+"""The wheel layout rules every kinematics calculator shares, and the axle lines they rest on.
 
 The one copy of these rules: the configuration loader reports them as problems of the file, and
-base_driver's calculators (thorvald_base.kinematics) refuse a layout with the same words, and take
-their wheel constraints from :func:`axle_lines` too.
+base_driver's calculators (thorvald_base.kinematics) refuse a layout with the same words, take
+their wheel constraints from :func:`axle_lines` too, and declare the rules of their own (which
+layouts they can serve) on top (``BaseCalculator.layout_rules``).
 
 A wheel that cannot steer (a type-1 drive, which rolls along base_link x, or a fixed passive wheel,
 which rolls along its yaw) cannot slide sideways, so the robot's centre of rotation must lie on
@@ -11,15 +12,13 @@ by sliding, which no calculator can command; that is a layout error, not a calcu
 
 Functions take the drives (``Drive``: ``name``, ``steerable``, ``x``, ``y``) and passive wheels
 (``PassiveWheel``: ``name``, ``fixed``, ``x``, ``y``, ``yaw``) of a configuration, so they serve a
-whole file and a calculator handed its drives alike. Calculators from other packages are only
-known to base_driver's plugin loader: their names get the common-axle rule alone here.
+whole file and a calculator handed its drives alike.
 """
 
 import math
 from dataclasses import dataclass
 from typing import List, Optional, Sequence, Tuple
 
-from .constants import DIFF_CALCULATOR, ONE_WHEEL_CALCULATOR, STD_CALCULATOR
 from .errors import Problem
 
 LINE_TOLERANCE = 1e-3  # [m] and [rad]: how far two axle lines may differ and still be one line
@@ -92,61 +91,10 @@ def common_axle(drives: Sequence, passive_wheels: Sequence = ()) -> Tuple[Option
     return (lines[0] if lines else None), problems
 
 
-def layout_problems(calculator: str, drives: Sequence, passive_wheels: Sequence = ()) -> List[Problem]:
-    """Every rule of the layout the named calculator would serve that these wheels break."""
-    axle, problems = common_axle(drives, passive_wheels)
-    if problems:
-        return problems
-    steered = [d for d in drives if d.steerable]
-    path = "base_calculator"
-    if calculator == STD_CALCULATOR:
-        if axle is None and len(steered) < 2:
-            problems.append(
-                Problem(
-                    path,
-                    calculator,
-                    "a single steered drive on casters cannot hold the robot's heading: the standard calculator "
-                    "needs two steered drives or a fixed axle (for one drive with fixed support wheels use "
-                    f"'{ONE_WHEEL_CALCULATOR}')",
-                )
-            )
-    elif calculator == DIFF_CALCULATOR:
-        diff = [d for d in drives if not d.steerable]
-        if len(drives) != 2 or len(diff) != 2:
-            problems.append(
-                Problem(
-                    path,
-                    calculator,
-                    "the differential calculator serves exactly two type-1 drives; this robot has "
-                    f"{len(drives)} drives, {len(diff)} of type 1",
-                )
-            )
-        elif abs(diff[0].y - diff[1].y) < LINE_TOLERANCE:
-            problems.append(
-                Problem(
-                    path, calculator, "the differential calculator needs its two wheels on either side (different y)"
-                )
-            )
-    elif calculator == ONE_WHEEL_CALCULATOR:
-        if len(drives) != 1 or not steered:
-            problems.append(
-                Problem(path, calculator, "the one-wheel-drive calculator serves exactly one type-0 (steered) drive")
-            )
-        elif axle is None:
-            problems.append(
-                Problem(
-                    path,
-                    calculator,
-                    "the one-wheel-drive calculator needs fixed passive wheels: their axle line is where the "
-                    "centre of rotation can lie",
-                )
-            )
-        elif axle.distance(drives[0].x, drives[0].y) < LINE_TOLERANCE:
-            problems.append(
-                Problem(
-                    "motor_drives." + drives[0].name,
-                    {"x": drives[0].x, "y": drives[0].y},
-                    "the single drive must not stand on the fixed wheels' axle line, or it cannot steer the robot",
-                )
-            )
-    return problems
+def shared_layout_problems(drives: Sequence, passive_wheels: Sequence = ()) -> List[Problem]:
+    """The layout rules every calculator shares: wheels that cannot steer share one axle line.
+
+    A calculator adds its own (``BaseCalculator.layout_rules`` in thorvald_base), checked after
+    these, so a calculator of another package gets the same checks as the built-in ones.
+    """
+    return common_axle(drives, passive_wheels)[1]

@@ -10,7 +10,7 @@ import math
 from typing import Callable, List, Mapping
 
 from .errors import MISSING, Problem
-from .layout import layout_problems
+from .layout import shared_layout_problems
 from .values import ALL_DIMENSIONS, FRAME_PART_DIMENSIONS, Drive, PassiveWheel, RobotConfig
 
 SAME_SPOT_DISTANCE = 0.01  # [m]: closer wheel contacts are a typing mistake, not a design
@@ -174,8 +174,9 @@ def frame_part_dimensions(config: RobotConfig, data: Mapping) -> List[Problem]:
 
 
 def wheel_layout(config: RobotConfig, data: Mapping) -> List[Problem]:
-    """The layout rules of :mod:`thorvald_model.layout` for the configuration's calculator."""
-    return layout_problems(config.base_calculator, config.drives, config.passive_wheels)
+    """The layout rules every calculator shares (:mod:`thorvald_model.layout`); the calculator's own
+    are its to declare and check (thorvald_base's BaseCalculator.layout_rules)."""
+    return shared_layout_problems(config.drives, config.passive_wheels)
 
 
 RULES: List[Rule] = [

@@ -35,6 +35,21 @@ def test_invalid_file_lists_every_problem_and_exits_2(bad_file, capsys):
     assert bad_file + ": motor_drives.drive2.r_wheel: 0: must be > 0" in err
 
 
+def test_the_calculators_own_layout_rules_are_checked_too(tmp_path, capsys):
+    """Which layouts a calculator serves is the calculator's rule (its plugin declares it): a
+    differential calculator on four steered drives is refused as base_driver would refuse it."""
+    path = tmp_path / "diff_on_four.yaml"
+    path.write_text(
+        yaml.safe_dump({"base_calculator": "pltf_clc_2wdiff::PltfClc2WDiff", "motor_drives": four_drives()})
+    )
+    assert main([str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: base_calculator: 'pltf_clc_2wdiff::PltfClc2WDiff': the differential calculator serves" in err
+    path.write_text(yaml.safe_dump({"base_calculator": "nowhere::Nothing", "motor_drives": four_drives()}))
+    assert main([str(path)]) == 2
+    assert "unknown base_calculator 'nowhere::Nothing': known calculators are" in capsys.readouterr().err
+
+
 def test_several_files_print_a_table(capsys):
     assert main([FIGURE5, *EXAMPLE_ROBOTS]) == 0
     lines = capsys.readouterr().out.splitlines()

@@ -298,12 +298,6 @@ def test_calculator_of_another_package_passes_the_loader(robot):
     assert parse_robot_config(robot).base_calculator == "my_pkg.calculators:MyCalculator"
 
 
-def test_standard_calculator_needs_two_steered_drives_or_a_fixed_axle(robot):
-    robot["motor_drives"] = {"drive0": std_drive(1, 0.5, 0.0)}
-    robot["passive_wheels"] = {"passive0": {"type": "caster", "x": -0.5, "y": 0.3}}
-    assert_problem(robot, "base_calculator", "single steered drive", "pltf_clc_1wd::PltfClc1WD")
-
-
 def test_wheels_that_cannot_steer_share_one_axle(robot):
     robot["motor_drives"]["drive0"].update(type=1, node=5)
     robot["motor_drives"]["drive2"].update(type=1, node=5, x=-0.3)
@@ -322,47 +316,7 @@ def test_fixed_passive_wheel_yaw_sets_its_axle(robot):
     assert_problem(robot, "passive_wheels.passive1", "share one axle line")
 
 
-def diff_robot():
-    return {
-        "base_calculator": "pltf_clc_2wdiff::PltfClc2WDiff",
-        "motor_drives": {"drive0": std_drive(1, 0.0, -0.3, type=1), "drive1": std_drive(1, 0.0, 0.3, type=1)},
-        "passive_wheels": {"passive0": {"type": "caster", "x": -0.6, "y": 0.0}},
-    }
-
-
-def test_differential_calculator_serves_two_type1_drives():
-    parse_robot_config(diff_robot())
-    robot = diff_robot()
-    robot["motor_drives"]["drive1"]["type"] = 0
-    robot["motor_drives"]["drive1"]["node"] = 2
-    assert_problem(robot, "base_calculator", "exactly two type-1 drives")
-
-
-def one_wheel_robot(drive_x=0.6):
-    return {
-        "base_calculator": "pltf_clc_1wd::PltfClc1WD",
-        "motor_drives": {"drive0": std_drive(1, drive_x, 0.0)},
-        "passive_wheels": {
-            "passive0": {"type": "fixed", "x": -0.4, "y": 0.35},
-            "passive1": {"type": "fixed", "x": -0.4, "y": -0.35},
-        },
-    }
-
-
-def test_one_wheel_calculator_needs_fixed_wheels():
-    parse_robot_config(one_wheel_robot())
-    robot = one_wheel_robot()
-    del robot["passive_wheels"]
-    assert_problem(robot, "base_calculator", "needs fixed passive wheels")
-
-
-def test_one_wheel_drive_must_not_stand_on_the_axle():
-    assert_problem(one_wheel_robot(drive_x=-0.4), "motor_drives.drive0", "axle line")
-
-
-def test_one_wheel_calculator_serves_one_steered_drive(robot):
-    robot["base_calculator"] = "pltf_clc_1wd::PltfClc1WD"
-    assert_problem(robot, "base_calculator", "exactly one type-0")
+# The layouts each calculator can serve are its own rules: thorvald_base's test_layout_rules.py.
 
 
 def test_beams_join_existing_drives(robot):

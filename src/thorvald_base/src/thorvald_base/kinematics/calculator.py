@@ -2,9 +2,10 @@
 
 A calculator turns a body twist into per-drive joint commands and measured drive states into
 odometry. It is pure: time and states come in as numbers. The shared logic lives here (template
-method, as python-can's ``recv``/``_recv_internal``); a built-in calculator sets ``name`` (its
-plugin name), which selects its layout rules in thorvald_model.layout, and, if it has a cheaper
-form, overrides ``_commands``. A calculator of another package may override ``_check_layout``.
+method, as python-can's ``recv``/``_recv_internal``); a calculator sets ``name`` (its plugin name),
+declares the layouts it can serve in ``layout_rules`` (checked after the rules every calculator
+shares, thorvald_model.layout), and, if it has a cheaper form, overrides ``_commands``. A calculator
+of another package does the same and gets the same checks.
 
 Lifecycle, as pluginlib's: construct with no arguments (or options), ``initialize(drives,
 passive_wheels)`` once, ``set_params(drives, passive_wheels)`` when parameters change at run time
@@ -14,7 +15,8 @@ passive_wheels)`` once, ``set_params(drives, passive_wheels)`` when parameters c
 import math
 from typing import List, Optional, Sequence
 
-from thorvald_model.layout import layout_problems
+from thorvald_model.errors import Problem
+from thorvald_model.layout import AxleLine, common_axle
 
 from ..errors import KinematicsError
 from .geometry import DEFAULT_PROJECTION, Layout, check_projection
@@ -148,12 +150,23 @@ class BaseCalculator:
         return twist.vx - twist.wz * layout.y[index], twist.vy + twist.wz * layout.x[index]
 
     # ---- what a calculator specialises ----------------------------------------------------
-    def _check_layout(self, drives: Sequence, passive_wheels: Sequence) -> None:
-        """Raises KinematicsError naming the problem if this calculator cannot serve the layout.
+    @classmethod
+    def layout_problems(cls, drives: Sequence, passive_wheels: Sequence = ()) -> List[Problem]:
+        """Every rule of the layout these wheels break for this calculator: the rules every
+        calculator shares (thorvald_model.layout), then, if they hold, the calculator's own."""
+        axle, problems = common_axle(drives, passive_wheels)
+        return problems or cls.layout_rules(drives, passive_wheels, axle)
 
-        The rules are the loader's (thorvald_model.layout), for this calculator's name.
-        """
-        problems = layout_problems(self.name or type(self).__name__, drives, passive_wheels)
+    @classmethod
+    def layout_rules(cls, drives: Sequence, passive_wheels: Sequence, axle: Optional[AxleLine]) -> List[Problem]:
+        """The layouts this calculator can serve: the problems of these wheels, given the axle line
+        every wheel that cannot steer shares (None if there is none). Each problem names the key
+        path (``base_calculator`` for the choice of calculator), the value and the rule."""
+        return []
+
+    def _check_layout(self, drives: Sequence, passive_wheels: Sequence) -> None:
+        """Raises KinematicsError naming the problems if this calculator cannot serve the layout."""
+        problems = self.layout_problems(drives, passive_wheels)
         if problems:
             raise KinematicsError("; ".join(p.rule for p in problems))
 

@@ -3,6 +3,8 @@
 from typing import List
 
 from thorvald_model.constants import DIFF_CALCULATOR
+from thorvald_model.errors import Problem
+from thorvald_model.layout import LINE_TOLERANCE
 
 from .calculator import BaseCalculator
 from .types import DriveCommand, Twist
@@ -18,6 +20,20 @@ class PltfClc2WDiff(BaseCalculator):
     """
 
     name = DIFF_CALCULATOR
+
+    @classmethod
+    def layout_rules(cls, drives, passive_wheels, axle):
+        diff = [d for d in drives if not d.steerable]
+        if len(drives) != 2 or len(diff) != 2:
+            rule = (
+                "the differential calculator serves exactly two type-1 drives; this robot has "
+                f"{len(drives)} drives, {len(diff)} of type 1"
+            )
+            return [Problem("base_calculator", cls.name, rule)]
+        if abs(diff[0].y - diff[1].y) < LINE_TOLERANCE:
+            rule = "the differential calculator needs its two wheels on either side (different y)"
+            return [Problem("base_calculator", cls.name, rule)]
+        return []
 
     def _commands(self, twist: Twist) -> List[DriveCommand]:
         return [DriveCommand(0.0, twist.vx - twist.wz * y) for y in self.layout.y]

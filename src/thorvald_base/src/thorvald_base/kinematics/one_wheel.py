@@ -1,6 +1,8 @@
 """The one-wheel-drive calculator, ``pltf_clc_1wd::PltfClc1WD`` (a design of ours: notes 3.3 found none)."""
 
 from thorvald_model.constants import ONE_WHEEL_CALCULATOR
+from thorvald_model.errors import Problem
+from thorvald_model.layout import LINE_TOLERANCE
 
 from .calculator import BaseCalculator
 
@@ -20,3 +22,20 @@ class PltfClc1WD(BaseCalculator):
     """
 
     name = ONE_WHEEL_CALCULATOR
+
+    @classmethod
+    def layout_rules(cls, drives, passive_wheels, axle):
+        if len(drives) != 1 or not drives[0].steerable:
+            rule = "the one-wheel-drive calculator serves exactly one type-0 (steered) drive"
+            return [Problem("base_calculator", cls.name, rule)]
+        if axle is None:
+            rule = (
+                "the one-wheel-drive calculator needs fixed passive wheels: their axle line is where the "
+                "centre of rotation can lie"
+            )
+            return [Problem("base_calculator", cls.name, rule)]
+        drive = drives[0]
+        if axle.distance(drive.x, drive.y) < LINE_TOLERANCE:
+            rule = "the single drive must not stand on the fixed wheels' axle line, or it cannot steer the robot"
+            return [Problem("motor_drives." + drive.name, {"x": drive.x, "y": drive.y}, rule)]
+        return []

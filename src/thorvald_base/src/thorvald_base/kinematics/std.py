@@ -1,6 +1,7 @@
 """The standard calculator, ``pltf_clc_std::PltfClcStd`` (paper 3.2, notes 3.1)."""
 
-from thorvald_model.constants import STD_CALCULATOR
+from thorvald_model.constants import ONE_WHEEL_CALCULATOR, STD_CALCULATOR
+from thorvald_model.errors import Problem
 
 from .calculator import BaseCalculator
 
@@ -19,3 +20,17 @@ class PltfClcStd(BaseCalculator):
     """
 
     name = STD_CALCULATOR
+
+    @classmethod
+    def layout_rules(cls, drives, passive_wheels, axle):
+        if axle is None and sum(1 for d in drives if d.steerable) < 2:
+            return [
+                Problem(
+                    "base_calculator",
+                    cls.name,
+                    "a single steered drive on casters cannot hold the robot's heading: the standard calculator "
+                    "needs two steered drives or a fixed axle (for one drive with fixed support wheels use "
+                    f"'{ONE_WHEEL_CALCULATOR}')",
+                )
+            ]
+        return []
