@@ -70,6 +70,41 @@ def in_install(install, script, timeout=120, check=True):
     return proc
 
 
+class InstallLaunch:
+    """A bash script run in the background with only the install space sourced, in a session of its
+    own; ended with SIGINT (roslaunch's own shutdown). ``output`` holds what it printed."""
+
+    def __init__(self, install, script):
+        self.install = install
+        self.proc = subprocess.Popen(
+            ["bash", "-c", f"source {shlex.quote(install)}/setup.bash && {script}"],
+            env=clean_env(),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            start_new_session=True,
+        )
+        self.output = ""
+
+    def wait_for(self, master, command, predicate):
+        """The output of command (run in the install space) once predicate holds, or None at STARTUP."""
+        deadline = time.time() + STARTUP
+        while time.time() < deadline and self.proc.poll() is None:
+            proc = in_install(self.install, f"{master} && timeout 15 {command}", check=False)
+            if proc.returncode == 0 and predicate(proc.stdout):
+                return proc.stdout
+            time.sleep(0.5)
+        return None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGINT)
+        self.output, _ = self.proc.communicate(timeout=60)
+
+
 def example(install, name):
     return os.path.join(install, "share", "thorvald_model", "config", name, name + ".yaml")
 
@@ -135,38 +170,17 @@ def test_base_bringup_launch(install):
     port = free_port()
     std = example(install, "thorvald_ii_4wd4ws_std")
     master = f"export ROS_MASTER_URI=http://localhost:{port}"
-    launch = subprocess.Popen(
-        [
-            "bash",
-            "-c",
-            f"source {install}/setup.bash && {master} && exec roslaunch -p {port} thorvald_base base_bringup.launch "
-            f"robot_model:={std} simple_sim:=true",
-        ],
-        env=clean_env(),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        start_new_session=True,
+    script = (
+        f"{master} && exec roslaunch -p {port} thorvald_base base_bringup.launch robot_model:={std} simple_sim:=true"
     )
-    try:
-        deadline = time.time() + STARTUP
-        frame = None
-        while time.time() < deadline and launch.poll() is None:
-            proc = in_install(
-                install, f"{master} && timeout 15 rostopic echo -n 1 /odometry/base_raw/child_frame_id", check=False
-            )
-            if proc.returncode == 0 and "base_link" in proc.stdout:
-                frame = proc.stdout
-                break
-            time.sleep(0.5)
+    with InstallLaunch(install, script) as launch:
+        frame = launch.wait_for(
+            master, "rostopic echo -n 1 /odometry/base_raw/child_frame_id", lambda o: "base_link" in o
+        )
         assert frame is not None, "no odometry from the installed base_driver"
         running = subprocess.run(["pgrep", "-af", "base_driver"], capture_output=True, text=True).stdout
         assert os.path.join(install, "lib", "thorvald_base", "base_driver") in running, running
-    finally:
-        if launch.poll() is None:
-            os.killpg(launch.pid, signal.SIGINT)
-        out, _ = launch.communicate(timeout=60)
-    assert "base_driver: 4 drives" in out, out[-3000:]
+    assert "base_driver: 4 drives" in launch.output, launch.output[-3000:]
 
 
 def test_every_module_is_installed_and_imports(install):
@@ -205,34 +219,18 @@ def test_base_driver_drives_the_can_emulator_from_the_install_space(install, tmp
     master = f"export ROS_MASTER_URI=http://localhost:{port}"
     script = (
         # the emulator runs on its own (no master needed); base_driver restarts until its port exists
-        f"source {install}/setup.bash && {master} && "
-        f"(rosrun thorvald_sim can_emulator {std} --ports 1 --link-dir {links} &) && "
+        f"{master} && (rosrun thorvald_sim can_emulator {std} --ports 1 --link-dir {links} &) && "
         f"exec roslaunch -p {port} thorvald_base base_bringup.launch robot_model:={std} simple_sim:=false "
         f"can_interface_type:=slcan can_interface_name:={links}/port0 respawn:=true respawn_delay:=1"
     )
-    launch = subprocess.Popen(
-        ["bash", "-c", script],
-        env=clean_env(),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        start_new_session=True,
-    )
     try:
-        deadline = time.time() + STARTUP
-        online = ""
-        while time.time() < deadline and launch.poll() is None:
-            proc = in_install(install, f"{master} && timeout 15 rostopic echo -n 1 /motor_controller_data", check=False)
-            if proc.returncode == 0 and proc.stdout.count("controller_mode: 3") == 4:
-                online = proc.stdout
-                break
-            time.sleep(0.5)
-        assert online, "the emulated motor controllers never came online for the installed base_driver"
-        odom = in_install(install, f"{master} && timeout 15 rostopic echo -n 1 /odometry/base_raw/child_frame_id")
-        assert "base_link" in odom.stdout
+        with InstallLaunch(install, script) as launch:
+            online = launch.wait_for(
+                master, "rostopic echo -n 1 /motor_controller_data", lambda o: o.count("controller_mode: 3") == 4
+            )
+            assert online, "the emulated motor controllers never came online for the installed base_driver"
+            odom = in_install(install, f"{master} && timeout 15 rostopic echo -n 1 /odometry/base_raw/child_frame_id")
+            assert "base_link" in odom.stdout
     finally:
-        if launch.poll() is None:
-            os.killpg(launch.pid, signal.SIGINT)
-        out, _ = launch.communicate(timeout=60)
         subprocess.run(["pkill", "-f", f"can_emulator {std} --ports 1 --link-dir {links}"], check=False)
-    assert "base_driver: 4 drives" in out, out[-3000:]
+    assert "base_driver: 4 drives" in launch.output, launch.output[-3000:]
