@@ -133,8 +133,20 @@ def test_code_and_package_files_come_from_the_install_space(install):
         "lib/thorvald_sim/spawn_robot",
         "share/thorvald_sim/launch/robot.launch",
         "share/thorvald_sim/worlds/tarmac_gravel.yaml",
+        "share/thorvald_model/meshes/hokuyo/hokuyo.dae",
+        # the original's package names: real files in the install space, not links back to src/
+        "share/thorvald_description/launch/model.launch",
+        "share/thorvald_description/urdf/thorvald_model.xacro",
+        "share/thorvald_description/meshes/hokuyo/hokuyo.dae",
+        "share/thorvald_twist_mux/launch/twist_mux.launch",
+        "share/thorvald_twist_mux/config/twist_mux.yaml",
+        "share/thorvald_example_robots/config/thorvald_ii_4wd4ws_std/thorvald_ii_4wd4ws_std.yaml",
+        "share/thorvald_example_robots/launch/thorvald_ii_4wd4ws_std_sim.launch",
+        "share/xacro/xacro",
+        "lib/xacro/xacro",
     ):
         assert os.path.exists(os.path.join(install, path)), path
+        assert not os.path.realpath(os.path.join(install, path)).startswith(os.path.join(WS, "src")), path
 
 
 def test_check_config_and_generate_urdf(install):
@@ -144,6 +156,12 @@ def test_check_config_and_generate_urdf(install):
     assert '<robot name="thorvald_ii_4wd4ws_std"' in urdf
     assert urdf.count("<joint ") == 34 and "thorvald_model/urdf/thorvald_model.xacro" in urdf
     assert install in urdf  # xacro's banner names the installed model
+    users = in_install(
+        install,
+        f"rosrun xacro xacro $(rospack find thorvald_description)/urdf/thorvald_model.xacro robot_config:={std} "
+        "tf_prefix:=thorvald_001",
+    ).stdout
+    assert 'link name="thorvald_001/base_link"' in users and install in users
 
 
 def test_kinematics_loads_a_plugin_through_the_installed_description(install):
