@@ -8,9 +8,10 @@ the joint's ``<gazebo reference>`` and the joint's damping) and the passive join
 wheels) with their friction. A URDF without the block (any other robot) is a passive model.
 """
 
+import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Dict, Iterable, Optional, Tuple
+from typing import Callable, Dict, Iterable, Optional, Tuple
 
 
 class DescriptionError(Exception):
@@ -167,3 +168,64 @@ def with_tyre_contact(xml: str, wheel_joints: Iterable[str], width: float) -> st
         for cylinder in link.findall("collision/geometry/cylinder"):
             cylinder.set("length", repr(min(float(cylinder.get("length")), width)))
     return ET.tostring(root, encoding="unicode")
+
+
+@dataclass(frozen=True)
+class MissingMesh:
+    """A visual or collision element dropped because its mesh file cannot be found."""
+
+    link: str
+    element: str  # "visual" or "collision"
+    uri: str  # as the description writes it, e.g. package://velodyne_description/meshes/VLP16_base_1.dae
+    reason: str  # e.g. "package velodyne_description is not installed"
+
+
+MeshFinder = Callable[[str], Tuple[Optional[str], str]]
+"""uri -> (absolute path of the file, "") or (None, why it cannot be found)."""
+
+
+def resolve_meshes(xml: str, find: MeshFinder) -> Tuple[str, Tuple[MissingMesh, ...]]:
+    """The URDF with every mesh file an absolute path, for pybullet, which loads the description from a
+    file of its own and would look for ``package://`` meshes next to it (and refuse the whole robot).
+
+    A visual or collision element whose mesh cannot be found (users' extras name meshes of packages
+    not installed here: ``velodyne_description``, ``kinect2_description``) is dropped, and said, so the
+    link is drawn and collides with its other geometry; a link left with none keeps its inertial.
+    """
+    root = ET.fromstring(xml)
+    missing = []
+    for link in root.findall("link"):
+        for kind in ("visual", "collision"):
+            for element in link.findall(kind):
+                mesh = element.find("geometry/mesh")
+                if mesh is None:
+                    continue
+                uri = mesh.get("filename", "")
+                path, reason = find(uri)
+                if path is None:
+                    link.remove(element)
+                    missing.append(MissingMesh(link.get("name", ""), kind, uri, reason))
+                else:
+                    mesh.set("filename", path)
+    return ET.tostring(root, encoding="unicode"), tuple(missing)
+
+
+def mesh_finder(package_path: Callable[[str], Optional[str]]) -> MeshFinder:
+    """A MeshFinder for ``package://PKG/...`` (package_path(PKG): its folder, None if not installed),
+    ``file://...`` and plain absolute paths; anything else (a relative path, Gazebo's ``model://``)
+    cannot be found from a description alone."""
+
+    def find(uri: str) -> Tuple[Optional[str], str]:
+        if uri.startswith("package://"):
+            package, _, rest = uri[len("package://") :].partition("/")
+            folder = package_path(package)
+            if folder is None:
+                return None, f"package {package} is not installed"
+            path = os.path.join(folder, rest)
+            return (path, "") if os.path.isfile(path) else (None, f"package {package} has no {rest}")
+        path = uri[len("file://") :] if uri.startswith("file://") else uri
+        if not os.path.isabs(path):
+            return None, "not a package://, file:// or absolute path"
+        return (path, "") if os.path.isfile(path) else (None, "no such file")
+
+    return find

@@ -74,6 +74,7 @@ class SimRobot:
         self.name = name
         self.description = description
         self.spawn_pose = pose
+        self.missing_meshes = ()  # the description's elements whose mesh could not be found (Simulation.spawn)
         wheels = [d.wheel_joint for d in description.drives]
         wheels += [j.name for j in description.passive_joints if j.name.endswith("wheel")]
         with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:

@@ -11,12 +11,22 @@ from typing import Dict, Optional, Tuple
 import numpy as np
 import pybullet as p
 
-from .description import DescriptionError, parse_description
+from .description import DescriptionError, MeshFinder, mesh_finder, parse_description, resolve_meshes
 from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
 from .scene import build_scene
 from .world import WorldConfig
 
 SOLVER_ITERATIONS = 50  # pybullet's default, set explicitly
+
+
+def installed_package_path(package: str) -> Optional[str]:
+    """The folder of a ROS package found through rospack (ROS_PACKAGE_PATH), None if it is not there."""
+    import rospkg  # noqa: PLC0415  (rospkg is not the ROS runtime; only needed when a description has meshes)
+
+    try:
+        return rospkg.RosPack().get_path(package)
+    except rospkg.ResourceNotFound:
+        return None
 
 
 class SpawnError(Exception):
@@ -41,12 +51,14 @@ class Simulation:
         world: WorldConfig,
         physics_rate: float = 240.0,
         tyre_contact_width: float = TYRE_CONTACT_WIDTH,
+        find_mesh: Optional[MeshFinder] = None,
     ):
         if not physics_rate > 0:
             raise ValueError(f"physics_rate: {physics_rate!r}: must be > 0 [Hz]")
         if not tyre_contact_width > 0.0:
             raise ValueError(f"tyre_contact_width: {tyre_contact_width!r}: must be > 0 [m]")
         self.tyre_contact_width = tyre_contact_width
+        self.find_mesh = find_mesh or mesh_finder(installed_package_path)
         self.client = client
         self.dt = 1.0 / physics_rate
         p.setPhysicsEngineParameter(
@@ -59,17 +71,22 @@ class Simulation:
         self.solver_cpu = 0.0  # [s] of this thread's CPU time spent in pybullet's stepSimulation, all steps
 
     def spawn(self, name: str, urdf: str, pose: Pose2D) -> SimRobot:
-        """Loads a robot; SpawnError (the world unchanged) if the name is taken or the URDF unusable."""
+        """Loads a robot; SpawnError (the world unchanged) if the name is taken or the URDF unusable.
+
+        Mesh files are resolved first; the elements whose mesh cannot be found are left out and
+        listed in the robot's ``missing_meshes``, for the caller to say so.
+        """
         if not name:
             raise SpawnError("a robot needs a name")
         if name in self.robots:
             raise SpawnError(f"a robot named {name!r} exists already")
         try:
-            robot = SimRobot(
-                self.client, name, parse_description(urdf), urdf, pose, tyre_contact_width=self.tyre_contact_width
-            )
+            description = parse_description(urdf)
+            urdf, missing = resolve_meshes(urdf, self.find_mesh)
+            robot = SimRobot(self.client, name, description, urdf, pose, tyre_contact_width=self.tyre_contact_width)
         except DescriptionError as e:
             raise SpawnError(f"{name}: {e}") from None
+        robot.missing_meshes = missing
         self.robots[name] = robot
         return robot
 

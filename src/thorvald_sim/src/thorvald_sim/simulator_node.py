@@ -223,6 +223,7 @@ class SimulatorNode:
         self.client = p.connect(p.GUI if self.gui else p.DIRECT)
         self.sim = Simulation(self.client, world, physics_rate, tyre)
         self.lock = threading.RLock()
+        self.missing_meshes_said = set()  # mesh URIs warned about: once each, however many robots name them
         self.io = {}
         self.clock = Every(clock_rate)
         self.odometry = Every(odometry_rate)
@@ -276,6 +277,16 @@ class SimulatorNode:
             except SpawnError as e:
                 rospy.logerr("simulator: refused to spawn: %s", e)
                 return SpawnRobotResponse(False, str(e))
+            for mesh in robot.missing_meshes:
+                if mesh.uri not in self.missing_meshes_said:
+                    self.missing_meshes_said.add(mesh.uri)
+                    rospy.logwarn(
+                        "simulator: %s: mesh %s not found (%s): link %s drawn from its other geometry",
+                        req.model_name,
+                        mesh.uri,
+                        mesh.reason,
+                        mesh.link,
+                    )
             topic = req.command_topic or robot.description.command_topic
             tf = self.default_tf if req.publish_tf < 0 else bool(req.publish_tf)
             self.io[req.model_name] = RobotIO(self, robot, req.robot_namespace, topic, tf)
