@@ -11,11 +11,12 @@ from hypothesis import strategies as st
 from thorvald_base.can import protocol as pr
 from thorvald_base.can.dbc import main, robot_dbc
 from thorvald_model import load_robot_config
+from thorvald_sim.can_emulator import load_dbc
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
 STD = os.path.join(SRC, "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
-DB = cantools.database.load_file(os.path.join(SRC, "thorvald_base", "can", "thorvald.dbc"))
+DB = load_dbc(os.path.join(SRC, "thorvald_base", "can", "thorvald.dbc"))
 
 
 def message(name):
@@ -106,6 +107,30 @@ def test_tx_pdo1_matches_the_dbc(rpm, steer, counts):
     assert pr.decode_tx_pdo1(back) == pr.TxPdo1(rpm, steer, counts)
 
 
+@given(int16, int32)
+def test_tx_pdo1_of_a_prop_prop_controller_matches_the_dbc(rpm_1, rpm_2):
+    """Channel 1's rpm in bytes 0-1, channel 2's in bytes 4-7 (reference notes 3.3), bytes 2-3 unused."""
+    data = pr.encode_tx_pdo1_diff(pr.TxPdo1Diff(rpm_1, rpm_2))
+    assert data[2:4] == b"\0\0"
+    assert int.from_bytes(data[0:2], "little", signed=True) == rpm_1
+    assert int.from_bytes(data[4:8], "little", signed=True) == rpm_2
+    assert message("RoboteqDiff_TxPDO1").decode(data) == {"prop_rpm_1": rpm_1, "prop_rpm_2": rpm_2}
+    back = message("RoboteqDiff_TxPDO1").encode({"prop_rpm_1": rpm_1, "prop_rpm_2": rpm_2})
+    assert pr.decode_tx_pdo1_diff(back) == pr.TxPdo1Diff(rpm_1, rpm_2)
+
+
+def test_a_prop_prop_robots_dbc_has_each_nodes_variant():
+    diff = os.path.join(SRC, "thorvald_model", "config", "thorvald_ii_2wd_diff", "thorvald_ii_2wd_diff.yaml")
+    with open(pr.dbc_path()) as f:
+        db = cantools.database.load_string(robot_dbc(f.read(), load_robot_config(diff)))
+    node = {d.node for d in load_robot_config(diff).drives}.pop()  # one prop/prop controller
+    m = db.get_message_by_frame_id(pr.TX_PDO1 + node)
+    assert m.name == f"RoboteqDiff_TxPDO1_node{node}"
+    assert m.decode(pr.encode_tx_pdo1_diff(pr.TxPdo1Diff(-1500, 2900))) == {"prop_rpm_1": -1500, "prop_rpm_2": 2900}
+    assert f"Roboteq_TxPDO1_node{node}" not in [x.name for x in db.messages]
+    assert db.get_message_by_frame_id(pr.TX_PDO3 + node).name == f"Roboteq_TxPDO3_node{node}"
+
+
 @given(int16, int16, int16, int16)
 def test_tx_pdo2_matches_the_dbc(a1, a2, p1, p2):
     m = pr.decode_tx_pdo2(pr.encode_tx_pdo2(pr.TxPdo2((a1 / 10, a2 / 10), (p1, p2))))
@@ -188,6 +213,7 @@ def test_every_frame_of_the_dbc_has_its_identifier_in_the_protocol():
 DECODERS = [
     pr.decode_pair,
     pr.decode_tx_pdo1,
+    pr.decode_tx_pdo1_diff,
     pr.decode_tx_pdo2,
     pr.decode_tx_pdo3,
     pr.decode_tx_pdo4,

@@ -15,6 +15,7 @@ is shut down; ``step`` then does nothing until ``attach`` gives it a new one).
 No ROS here; ``can_emulator_node`` wraps it. Times are seconds of the caller's clock.
 """
 
+import logging
 import math
 import random
 from dataclasses import dataclass, field
@@ -32,12 +33,26 @@ CAPACITY_AH = 100.0
 RX_MESSAGES = {0x200: "Roboteq_RxPDO1", 0x300: "Roboteq_RxPDO2", 0x400: "Roboteq_RxPDO3", 0x500: "Roboteq_RxPDO4"}
 
 
+class _SameIdentifierVariants(logging.Filter):
+    """cantools says when two messages share an identifier; in thorvald.dbc a prop/prop controller's
+    TxPDO1 (RoboteqDiff_) shares the prop/steer one's on purpose: messages are looked up by name."""
+
+    def filter(self, record):
+        return "RoboteqDiff_" not in record.getMessage()
+
+
 def load_dbc(path: Optional[str] = None):
     if path is None:
         from thorvald_base.can.protocol import dbc_path  # noqa: PLC0415  (where the file is, not how to read it)
 
         path = dbc_path()
-    return cantools.database.load_file(path)
+    log = logging.getLogger("cantools.database.can.database")
+    variants = _SameIdentifierVariants()
+    log.addFilter(variants)
+    try:
+        return cantools.database.load_file(path)
+    finally:
+        log.removeFilter(variants)
 
 
 @dataclass
@@ -116,16 +131,12 @@ class CanEmulator:
         self.bus = bus
         self.db = dbc or load_dbc()
         self.rng = random.Random(seed)
-        by_node: Dict[int, list] = {}
-        for d in config.drives:
-            by_node.setdefault(d.node, []).append(d)
+        # the robot's devices as the configuration says (the loader's facts; the frames stay the DBC's)
         self.controllers = {
-            node: EmulatedController(
-                node, [EmulatedDrive(d) for d in sorted(ds, key=lambda d: d.channel)], len(ds) == 1 and ds[0].steerable
-            )
-            for node, ds in by_node.items()
+            c.node: EmulatedController(c.node, [EmulatedDrive(d) for d in c.drives], c.steered)
+            for c in config.motor_controllers
         }
-        self.batteries = {b.id: EmulatedBattery(b.id) for b in config.batteries if b.type == 1 and b.with_battery}
+        self.batteries = {b.id: EmulatedBattery(b.id) for b in config.present_batteries}
         self.ios = {b.id: EmulatedIo(b.id, b.type, [False, False]) for b in config.io_boards_on_bus}
         self.to_corrupt = 0
         self.sent = 0
@@ -285,14 +296,14 @@ class CanEmulator:
                 "steer_rpm": round(self._steer_rpm(ch)),
                 "steer_counts": ch.counts(),
             }
+            self._send(c, "Roboteq_TxPDO1", 0x180 + c.node, values)
         else:
             second = c.channels[1] if len(c.channels) > 1 else None
             values = {
-                "prop_rpm": round(ch.rpm_of(ch.speed)),
-                "steer_rpm": round(second.rpm_of(second.speed)) if second else 0,
-                "steer_counts": 0,
+                "prop_rpm_1": round(ch.rpm_of(ch.speed)),
+                "prop_rpm_2": round(second.rpm_of(second.speed)) if second else 0,
             }
-        self._send(c, "Roboteq_TxPDO1", 0x180 + c.node, values)
+            self._send(c, "RoboteqDiff_TxPDO1", 0x180 + c.node, values)
 
     @staticmethod
     def _steer_rpm(ch: EmulatedDrive) -> float:

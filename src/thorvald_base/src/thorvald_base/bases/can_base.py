@@ -88,7 +88,7 @@ class CanBase(BaseHandle):
         self._reopen = reopen  # () -> a new bus, after bus errors
         self._next_reopen = 0.0  # [s] monotonic
         self.counters = BusCounters()
-        self.controllers_ = [MotorController(c.node, c.drives, c.indices) for c in config.motor_controllers]
+        self.controllers_ = [MotorController(c) for c in config.motor_controllers]
         self.batteries_ = [Battery(b) for b in config.present_batteries]
         self.ios = [IoBoard(b) for b in self.io_config]
         try:

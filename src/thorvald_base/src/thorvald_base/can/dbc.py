@@ -16,10 +16,12 @@ _VALUES = re.compile(r"^VAL_ (\d+) (.*)$")
 
 
 def devices_of(config) -> Dict[str, List[Tuple[int, str]]]:
-    """Message name prefix -> (id offset, name suffix) per device of the robot."""
-    nodes = sorted(c.node for c in config.motor_controllers)
+    """Message name prefix -> (id offset, name suffix) per device of the robot. ``RoboteqDiff_``
+    messages are the prop/prop controllers' variants of ``Roboteq_`` ones at the same identifier."""
+    controllers = sorted(config.motor_controllers, key=lambda c: c.node)
     return {
-        "Roboteq_": [(n, f"node{n}") for n in nodes],
+        "Roboteq_": [(c.node, f"node{c.node}") for c in controllers],
+        "RoboteqDiff_": [(c.node, f"node{c.node}") for c in controllers if not c.steered],
         "Battery_": [(b.id, f"bat{b.id}") for b in config.present_batteries],
         "IO_": [(b.id, f"io{b.id}") for b in config.io_boards_on_bus],
     }
@@ -54,9 +56,14 @@ def robot_dbc(template: str, config) -> str:
         k += 1
     out = list(header)
     copies = []  # (new id, base id)
+    # a prop/prop controller sends its own variant of these (same identifier, other signals)
+    variants = {base for base, name, _, _ in blocks if name.startswith("RoboteqDiff_")}
+    prop_prop = {offset for offset, _ in devices.get("RoboteqDiff_", [])}
     for base, name, rest, signals in blocks:
         prefix = next((p for p in devices if name.startswith(p)), None)
         for offset, suffix in devices.get(prefix, []):
+            if prefix == "Roboteq_" and base in variants and offset in prop_prop:
+                continue
             copies.append((base + offset, base))
             out.append(f"BO_ {base + offset} {name}_{suffix}:{rest}")
             out.extend(signals)

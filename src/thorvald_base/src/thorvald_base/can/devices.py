@@ -5,9 +5,10 @@ to send. Times are seconds of the caller's clock (base_driver's cycle time). A d
 LOST_AFTER seconds is in lost connection until it is heard again; any frame it owns counts.
 """
 
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple, Union
 
 from ..kinematics import DriveCommand
+from ..modes import MODE_PRE_INITIATION
 from . import protocol as pr
 
 LOST_AFTER = 2.0  # [s] without a frame from a device
@@ -42,22 +43,23 @@ class Device:
 class MotorController(Device):
     """One Roboteq FBL2360: a type-0 drive (prop/steer) or a pair of type-1 drives (prop/prop)."""
 
-    def __init__(self, node: int, drives: Sequence, indices: Sequence[int]):
-        super().__init__(pr.roboteq_ids(node))
-        self.node = node
-        self.drives = list(drives)  # thorvald_model Drive, channel order
-        self.indices = list(indices)  # their places in the robot's drive order
-        self.steered = len(self.drives) == 1 and self.drives[0].steerable
+    def __init__(self, controller):
+        """controller: the configuration's (thorvald_model MotorController): node, drives, indices."""
+        super().__init__(pr.roboteq_ids(controller.node))
+        self.node = controller.node
+        self.drives = list(controller.drives)  # thorvald_model Drive, channel order
+        self.indices = list(controller.indices)  # their places in the robot's drive order
+        self.steered = controller.steered
         self.scalings = [pr.DriveScaling.of(d) for d in self.drives]
         self.name = self.drives[0].name
         self.sequence = 0
-        self.tx1: Optional[pr.TxPdo1] = None
+        self.tx1: Optional[Union[pr.TxPdo1, pr.TxPdo1Diff]] = None
         self.tx2: Optional[pr.TxPdo2] = None
         self.tx3: Optional[pr.TxPdo3] = None
         self.homing_setup: Optional[pr.TxPdo4] = None
         self.script: Optional[pr.TxPdo4] = None
         self.encoders: Optional[pr.TxPdo4] = None
-        self.mode = pr.MODE_PRE_INITIATION
+        self.mode = MODE_PRE_INITIATION  # RxPDO3 takes the BaseState modes
 
     def set_drives(self, drives: Sequence) -> None:
         self.drives = list(drives)
@@ -87,7 +89,7 @@ class MotorController(Device):
     def _decode(self, can_id: int, data: bytes) -> None:
         function = can_id - self.node
         if function == pr.TX_PDO1:
-            self.tx1 = pr.decode_tx_pdo1(data)
+            self.tx1 = pr.decode_tx_pdo1(data) if self.steered else pr.decode_tx_pdo1_diff(data)
         elif function == pr.TX_PDO2:
             self.tx2 = pr.decode_tx_pdo2(data)
         elif function == pr.TX_PDO3:
@@ -115,10 +117,8 @@ class MotorController(Device):
                     s[0].wheel_speed(self.tx1.prop_rpm),
                 )
             ]
-        out = [(0.0, 0.0, s[0].wheel_speed(self.tx1.prop_rpm))]
-        if len(self.drives) > 1:
-            out.append((0.0, 0.0, s[1].wheel_speed(self.tx1.steer_rpm)))
-        return out
+        rpms = (self.tx1.prop_rpm_1, self.tx1.prop_rpm_2)
+        return [(0.0, 0.0, scaling.wheel_speed(rpm)) for scaling, rpm in zip(s, rpms)]
 
     @property
     def type_name(self) -> str:

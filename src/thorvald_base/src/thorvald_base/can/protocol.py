@@ -62,13 +62,6 @@ IO_ANALOG_INPUTS = 3
 MAX_NODE = 127
 COMMAND_FULL_SCALE = 1000  # a propulsion or steering command of +-1000 is full scale
 
-# ---- modes (RxPDO3; the BaseState MODE_* values; only -99 is the original's known number) ----
-MODE_DRIVE = 0
-MODE_HOME = 1
-MODE_DECOUPLED = 2
-MODE_ONLINE = 3
-MODE_LOST_CONNECTION = 4
-MODE_PRE_INITIATION = -99
 
 # ---- script types (TxPDO4 type 2, byte 4; ours) -----------------------------------------------
 SCRIPT_PROP_STEER = 1
@@ -126,6 +119,7 @@ HEARTBEAT_OPERATIONAL = 0x05
 
 _II = struct.Struct("<ii")
 _HHI = struct.Struct("<hhi")
+_Hxxi = struct.Struct("<hxxi")
 _HHHH = struct.Struct("<hhhh")
 _BBhhh = struct.Struct("<BBhhh")
 _BBhHbb = struct.Struct("<BBhHbb")
@@ -212,9 +206,20 @@ def decode_pair(data: bytes) -> Tuple[int, int]:
 # ---- Roboteq: frames from the controller ----------------------------------------------------
 @dataclass(frozen=True)
 class TxPdo1:
-    prop_rpm: int  # propulsion motor rpm (channel 1)
-    steer_rpm: int  # steering motor rpm; prop/prop: channel 2's propulsion rpm
-    steer_counts: int  # steering encoder counts (0 for prop/prop)
+    """TxPDO1 of a prop/steer controller (a type-0 drive)."""
+
+    prop_rpm: int  # propulsion motor rpm
+    steer_rpm: int  # steering motor rpm (ours)
+    steer_counts: int  # steering encoder counts
+
+
+@dataclass(frozen=True)
+class TxPdo1Diff:
+    """TxPDO1 of a prop/prop controller (a pair of type-1 drives): channel 1's rpm in bytes 0-1,
+    channel 2's in bytes 4-7 (reference notes 3.3, RoboteqFbl2360Diff), bytes 2-3 unused."""
+
+    prop_rpm_1: int
+    prop_rpm_2: int
 
 
 @dataclass(frozen=True)
@@ -250,6 +255,15 @@ def encode_tx_pdo1(m: TxPdo1) -> bytes:
 def decode_tx_pdo1(data: bytes) -> TxPdo1:
     _length(data, 8)
     return TxPdo1(*_HHI.unpack(bytes(data)))
+
+
+def encode_tx_pdo1_diff(m: TxPdo1Diff) -> bytes:
+    return _Hxxi.pack(_int16(m.prop_rpm_1), _int32(m.prop_rpm_2))
+
+
+def decode_tx_pdo1_diff(data: bytes) -> TxPdo1Diff:
+    _length(data, 8)
+    return TxPdo1Diff(*_Hxxi.unpack(bytes(data)))
 
 
 def encode_tx_pdo2(m: TxPdo2) -> bytes:
