@@ -40,6 +40,7 @@ from tf2_msgs.msg import TFMessage
 
 from thorvald_base.conversions import quaternion_yaw
 from thorvald_msgs.msg import BaseState
+from thorvald_testing import poll  # noqa: F401  (the suite polls through this module: nh.poll)
 
 PREFIX = "thvnet"  # every namespace of these tests is named PREFIX<pid>-<host>
 SUBNET = "10.213.0"  # the hosts' /24 (private, on veth interfaces only)
@@ -430,19 +431,6 @@ class AgentClient:
             self.proc.popen.stdin.flush()
         except (OSError, ValueError):
             pass
-
-
-def poll(predicate, timeout, what, interval=0.05):
-    """predicate()'s first true value; AssertionError naming what (a string or a callable giving one)
-    after timeout [s] of wall time."""
-    deadline = time.monotonic() + timeout
-    while True:
-        value = predicate()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what() if callable(what) else what}")
-        time.sleep(interval)
 
 
 # ---- the namespace side: wait-master and the agent -----------------------------------------------

@@ -16,8 +16,6 @@ assertion; one test per robot (ids are the robots' names) checks its legs.
 import json
 import math
 import os
-import signal
-import socket
 import subprocess
 import sys
 import time
@@ -27,6 +25,9 @@ import pytest
 from every_robot_driver import plan_for
 
 from thorvald_model import load_robot_config
+from thorvald_testing import Launch, processes_naming
+
+pytestmark = pytest.mark.slow
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CONFIG = os.path.normpath(os.path.join(HERE, "..", "src", "thorvald_model", "config"))
@@ -89,42 +90,6 @@ def launch_file(robots):
     return "\n".join([*lines, "</launch>", ""])
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def ours(marker):
-    """Processes whose command line names marker (our temporary folder: roslaunch hands every node
-    and the master a __log path in it), other than this process."""
-    out = subprocess.run(["pgrep", "-f", marker], capture_output=True, text=True).stdout.split()
-    return [int(p) for p in out if int(p) != os.getpid()]
-
-
-def stop(launch, marker):
-    """SIGINT to roslaunch stops its nodes (each in a session of its own) and the master it started;
-    whatever is left after that is killed. Returns the command lines of what had to be killed."""
-    if launch.poll() is None:
-        try:
-            os.killpg(launch.pid, signal.SIGINT)
-            launch.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            os.killpg(launch.pid, signal.SIGKILL)
-            launch.wait(timeout=10)
-        except ProcessLookupError:
-            launch.wait(timeout=10)
-    killed = []
-    for pid in ours(marker):
-        try:
-            with open(f"/proc/{pid}/cmdline", "rb") as f:
-                killed.append(f.read().replace(b"\0", b" ").decode(errors="replace"))
-            os.kill(pid, signal.SIGKILL)
-        except OSError:
-            pass
-    return killed
-
-
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
     """Starts everything, drives, stops everything; the driver's report, with the wall times and
@@ -132,31 +97,13 @@ def run(tmp_path_factory):
     home = tmp_path_factory.mktemp("every_robot")
     marker = str(home)
     (home / "all.launch").write_text(launch_file(ROBOTS))
-    port = free_port()
-    env = dict(os.environ)
-    for name in ("TMUX", "ROS_NAMESPACE", "ROS_IP", "ROS_HOSTNAME"):
-        env.pop(name, None)
-    env.update(
-        ROS_MASTER_URI=f"http://localhost:{port}",
-        ROS_HOME=str(home),
-        ROS_LOG_DIR=str(home / "log"),
-        PYTHONUNBUFFERED="1",
-    )
     wall0 = time.monotonic()
-    with open(home / "roslaunch.out", "w") as out:
-        launch = subprocess.Popen(
-            ["roslaunch", "-p", str(port), str(home / "all.launch")],
-            env=env,
-            stdin=subprocess.DEVNULL,
-            stdout=out,
-            stderr=subprocess.STDOUT,
-            start_new_session=True,
-        )
+    launch = Launch(home, str(home / "all.launch"))
     try:
         try:
             driver = subprocess.run(
                 [sys.executable, DRIVER, *(f"{n}={robot_file(n)}" for n in ROBOTS)],
-                env=env,
+                env=launch.env,
                 stdin=subprocess.DEVNULL,
                 capture_output=True,
                 text=True,
@@ -166,12 +113,12 @@ def run(tmp_path_factory):
         except subprocess.TimeoutExpired as e:
             stderr = e.stderr.decode(errors="replace") if isinstance(e.stderr, bytes) else e.stderr or ""
             driver, failure = None, f"did not finish within {DRIVER_LIMIT:.0f} s:\n{stderr[-3000:]}"
-        running = len(ours(marker))
+        running = len(processes_naming(marker))
     finally:
-        left = stop(launch, marker)
+        left = launch.stop()
     wall = time.monotonic() - wall0
     if failure:
-        tail = (home / "roslaunch.out").read_text()[-3000:]
+        tail = launch.tail()
         pytest.fail(f"every_robot_driver {failure}\nroslaunch's output ends:\n{tail}", pytrace=False)
     report = json.loads(driver.stdout.strip().splitlines()[-1])
     report.update(wall=wall, left=left, running=running)

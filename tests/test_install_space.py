@@ -13,11 +13,14 @@ import json
 import os
 import shlex
 import signal
-import socket
 import subprocess
 import time
 
 import pytest
+
+from thorvald_testing import free_port
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 WS = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 VENV_PYTHON = os.path.join(WS, ".venv", "bin", "python")
@@ -176,12 +179,6 @@ def test_kinematics_loads_a_plugin_through_the_installed_description(install):
         'print(CalculatorLoader().plugins["pltf_clc_2wdiff::PltfClc2WDiff"].source)\'',
     ).stdout.strip()
     assert source == os.path.join(install, "share", "thorvald_base", "calculator_plugins.xml")
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def test_base_bringup_launch(install):

@@ -50,6 +50,8 @@ import time
 import netns_helpers as nh
 import pytest
 
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.root]
+
 MASTER_URI = f"http://{nh.SUBNET}.1:{nh.MASTER_PORT}"
 SUBNET = ipaddress.ip_network(f"{nh.SUBNET}.0/24")
 CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src", "thorvald_model", "config")

@@ -9,6 +9,8 @@ import subprocess
 import pytest
 import rosbag
 
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
 WS = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 TOPICS = ("nav_vel", "twist_mux/cmd_vel", "odometry/base_raw", "odometry/gazebo", "base_state")
 EXAMPLES = sorted(glob.glob(os.path.join(WS, "src", "thorvald_model", "config", "*", "*.yaml")))

@@ -11,6 +11,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 PACKAGES = ["thorvald_base", "thorvald_bringup", "thorvald_model", "thorvald_sim", "thorvald_teleop"]
 # The modules whose job is ROS or physics, and why; everything else must be pure.
 NOT_PURE = {
@@ -76,6 +78,7 @@ def imported_forbidden():
     return json.loads(out.stdout)
 
 
+@pytest.mark.slow  # a fresh interpreter per module: about 15 s
 def test_every_module_but_the_ros_ones_imports_nothing_of_the_ros_runtime():
     found = imported_forbidden()
     # the walk really finds the core, new subpackages included

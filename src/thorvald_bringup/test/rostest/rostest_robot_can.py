@@ -20,6 +20,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from thorvald_msgs.msg import BaseState, ControllerArray
+from thorvald_testing import poll
 
 STARTUP = 60.0  # [s]: the emulator, base_driver's respawn and SLCAN's 2 s open on a busy machine
 SPEED = 0.3  # [m/s]
@@ -40,16 +41,6 @@ class Latest:
             return self.msg
 
 
-def wait_for(predicate, timeout, what):
-    deadline = time.time() + timeout
-    while time.time() < deadline and not rospy.is_shutdown():
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
-
-
 class RobotOverCanTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -60,7 +51,7 @@ class RobotOverCanTest(unittest.TestCase):
         cls.tf = tf2_ros.Buffer()
         cls.listener = tf2_ros.TransformListener(cls.tf)
         # online: base_driver heard every motor controller over the bus (mode 3, as the can_slcan test)
-        wait_for(
+        poll(
             lambda: (
                 cls.controllers.get() is not None
                 and len(cls.controllers.get().controllers) == 4
@@ -69,8 +60,8 @@ class RobotOverCanTest(unittest.TestCase):
             STARTUP,
             "base_driver to report its four motor controllers online over CAN",
         )
-        wait_for(lambda: cls.state.get() is not None, STARTUP, "base_state")
-        wait_for(lambda: cls.nav.get_num_connections() > 0, STARTUP, "twist_mux to subscribe nav_vel")
+        poll(lambda: cls.state.get() is not None, STARTUP, "base_state")
+        poll(lambda: cls.nav.get_num_connections() > 0, STARTUP, "twist_mux to subscribe nav_vel")
 
     def test_the_model_is_loaded_for_the_robot(self):
         description = rospy.get_param("robot_description")
@@ -90,7 +81,7 @@ class RobotOverCanTest(unittest.TestCase):
             speeds.append(min(state.prop_speed))
         # the measured wheel speeds (encoders over CAN) reached the command
         self.assertGreater(max(speeds), 0.95 * SPEED)
-        wait_for(lambda: max(abs(v) for v in self.state.get().prop_speed) < 0.01, 10.0, "the wheels to stop")
+        poll(lambda: max(abs(v) for v in self.state.get().prop_speed) < 0.01, 10.0, "the wheels to stop")
         moved = self.odom.get().pose.pose.position.x - start
         # 3 s at 0.3 m/s less the ramps (prp_sim_a 1.5 m/s^2) and the command timeout: 0.7 .. 1.1 m
         self.assertGreater(moved, 0.6)

@@ -5,6 +5,7 @@ Xvfb on a free display; both stop when the test ends. About 20-30 s."""
 import os
 
 import numpy as np
+import pytest
 from urdf_helpers import PKG
 
 from thorvald_model import load_robot_config
@@ -16,6 +17,8 @@ from thorvald_model.rviz_capture import (
     write_rviz_config,
     xvfb,
 )
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 STD = os.path.join(PKG, "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
 WIDTH, HEIGHT = 640, 480

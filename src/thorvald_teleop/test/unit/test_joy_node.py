@@ -15,9 +15,9 @@ import threading
 import time
 
 import pytest
-from teleop_test_helpers import START, stop_group
 
 from thorvald_teleop.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from thorvald_testing import START, stop_group
 
 TIMEOUT = 10.0  # [s] for a message that should come
 OK, ERROR = 0, 2

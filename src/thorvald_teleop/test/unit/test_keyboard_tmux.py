@@ -21,9 +21,9 @@ import threading
 import time
 
 import pytest
-from teleop_test_helpers import START, children, poll, stop_group
 
 from thorvald_teleop.keyboard_node import RawTerminal
+from thorvald_testing import START, children, poll, stop_group
 
 
 @pytest.fixture(autouse=True)
