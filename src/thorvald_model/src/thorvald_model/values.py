@@ -343,7 +343,7 @@ class RobotConfig:
 
     def description_dict(self) -> Dict[str, Any]:
         """:meth:`to_dict` with the derived facts the model's xacro draws by, under ``derived`` of
-        each drive and battery entry (never fed back to the loader)."""
+        each drive, battery and passive wheel entry (never fed back to the loader)."""
         out = self.to_dict()
         for d in self.drives:
             out["motor_drives"][d.name]["derived"] = {
@@ -354,6 +354,8 @@ class RobotConfig:
             }
         for b in self.batteries:
             out["batteries"][b.name]["derived"] = {"present": b.present}
+        for w in self.passive_wheels:
+            out["passive_wheels"][w.name]["derived"] = {"caster": not w.fixed}
         return out
 
     def with_drive_param(self, index: int, key: str, value: Any) -> "RobotConfig":
