@@ -13,6 +13,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Callable, Dict, Iterable, Optional, Tuple
 
+from .sensor_blocks import Datum
+
 
 class DescriptionError(Exception):
     """A robot description the simulator cannot use; the message says why."""
@@ -60,6 +62,7 @@ class RobotDescription:
     odometry_topic: str = "odometry/gazebo"
     odometry_frame: str = "odom"
     base_frame: str = "base_link"
+    datum: Optional[Datum] = None  # the generator's <datum> (from model.launch's datum_file)
 
     @property
     def passive_joints(self) -> Tuple[JointInfo, ...]:
@@ -147,7 +150,66 @@ def parse_description(xml: str) -> RobotDescription:
         plugin.findtext("odometryTopic") or "odometry/gazebo",
         plugin.findtext("odometryFrame") or "odom",
         plugin.findtext("robotBaseFrame") or "base_link",
+        _datum(plugin.find("datum")),
     )
+
+
+def _datum(element) -> Optional[Datum]:
+    """The generator's ``<datum latitude= longitude= heading= [altitude=]/>`` (robot_localization's datum:
+    degrees, degrees, ENU yaw [rad])."""
+    if element is None:
+        return None
+    values = [_float(element.get(k), f"datum {k}") for k in ("latitude", "longitude", "heading", "altitude")]
+    if not -90.0 <= values[0] <= 90.0:
+        raise DescriptionError(f"datum latitude: {values[0]!r} must be in [-90, 90]")
+    return Datum(*values)
+
+
+@dataclass(frozen=True)
+class Origin:
+    """A joint's <origin>: translation [m], then roll, pitch, yaw [rad] about fixed axes."""
+
+    xyz: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class ParentJoint:
+    """How a link hangs from its parent: the joint's name, type and origin."""
+
+    parent: str
+    joint: str
+    type: str
+    origin: Origin
+
+
+def link_tree(xml: str) -> Dict[str, ParentJoint]:
+    """Each child link's joint to its parent (the root link has none)."""
+    root = ET.fromstring(xml)
+    tree = {}
+    for j in root.findall("joint"):
+        parent, child = j.find("parent"), j.find("child")
+        if parent is None or child is None:
+            continue
+        origin = j.find("origin")
+        xyz = _triple(origin.get("xyz") if origin is not None else None, f"joint {j.get('name')} origin xyz")
+        rpy = _triple(origin.get("rpy") if origin is not None else None, f"joint {j.get('name')} origin rpy")
+        tree[child.get("link", "")] = ParentJoint(
+            parent.get("link", ""), j.get("name", ""), j.get("type", ""), Origin(xyz, rpy)
+        )
+    return tree
+
+
+def _triple(text: Optional[str], what: str) -> Tuple[float, float, float]:
+    if not text:
+        return (0.0, 0.0, 0.0)
+    try:
+        values = tuple(float(v) for v in text.split())
+    except ValueError:
+        values = ()
+    if len(values) != 3:
+        raise DescriptionError(f"{what}: {text!r} is not 3 numbers")
+    return values  # type: ignore[return-value]
 
 
 def with_tyre_contact(xml: str, wheel_joints: Iterable[str], width: float) -> str:

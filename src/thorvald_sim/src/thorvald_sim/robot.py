@@ -75,6 +75,9 @@ class SimRobot:
         self.description = description
         self.spawn_pose = pose
         self.missing_meshes = ()  # the description's elements whose mesh could not be found (Simulation.spawn)
+        self.sensors = []  # thorvald_sim.sensors.Sensor of its Gazebo sensor blocks (Simulation.spawn)
+        self.sensor_blocks = None  # thorvald_sim.sensor_blocks.SensorBlocks: also what is not simulated
+        self.sensor_problems = []  # sensors that could not be mounted
         wheels = [d.wheel_joint for d in description.drives]
         wheels += [j.name for j in description.passive_joints if j.name.endswith("wheel")]
         with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
@@ -259,6 +262,20 @@ class SimRobot:
         lin, _ = p.multiplyTransforms(*inverse, v_origin, (0.0, 0.0, 0.0, 1.0))
         ang, _ = p.multiplyTransforms(*inverse, w, (0.0, 0.0, 0.0, 1.0))
         return tuple(lin), tuple(ang)
+
+    def link_state(self, index: int) -> Tuple[Vec3, Quat, Vec3, Vec3, Vec3]:
+        """A loaded link's frame in the world, its centre of mass and velocities: (frame position,
+        frame orientation, centre of mass [m], linear velocity of the centre of mass [m/s], angular
+        velocity [rad/s]), all in world axes. index -1 is the base (base_link and every link merged
+        into it)."""
+        c = self.client
+        if index < 0:
+            com, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=c)
+            v, w = p.getBaseVelocity(self.body, physicsClientId=c)
+            pos, quat = p.multiplyTransforms(com, orn, *self._to_base_link)
+            return tuple(pos), tuple(quat), tuple(com), tuple(v), tuple(w)
+        state = p.getLinkState(self.body, index, computeLinkVelocity=1, computeForwardKinematics=1, physicsClientId=c)
+        return tuple(state[4]), tuple(state[5]), tuple(state[0]), tuple(state[6]), tuple(state[7])
 
     # ---- life -------------------------------------------------------------------------------
     def reset(self) -> None:

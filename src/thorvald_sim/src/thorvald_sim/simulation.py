@@ -14,6 +14,8 @@ import pybullet as p
 from .description import DescriptionError, MeshFinder, mesh_finder, parse_description, resolve_meshes
 from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
 from .scene import build_scene
+from .sensor_blocks import Datum, read_sensor_blocks
+from .sensors import build_sensors
 from .world import WorldConfig
 
 SOLVER_ITERATIONS = 50  # pybullet's default, set explicitly
@@ -52,12 +54,18 @@ class Simulation:
         physics_rate: float = 240.0,
         tyre_contact_width: float = TYRE_CONTACT_WIDTH,
         find_mesh: Optional[MeshFinder] = None,
+        *,
+        seed: int = 0,
+        datum: Optional[Datum] = None,
     ):
         if not physics_rate > 0:
             raise ValueError(f"physics_rate: {physics_rate!r}: must be > 0 [Hz]")
         if not tyre_contact_width > 0.0:
             raise ValueError(f"tyre_contact_width: {tyre_contact_width!r}: must be > 0 [m]")
         self.tyre_contact_width = tyre_contact_width
+        self.seed = seed  # of every sensor's noise
+        self.datum = datum  # the GNSS reference of robots whose description gives none
+        self.world = world
         self.find_mesh = find_mesh or mesh_finder(installed_package_path)
         self.client = client
         self.dt = 1.0 / physics_rate
@@ -74,7 +82,10 @@ class Simulation:
         """Loads a robot; SpawnError (the world unchanged) if the name is taken or the URDF unusable.
 
         Mesh files are resolved first; the elements whose mesh cannot be found are left out and
-        listed in the robot's ``missing_meshes``, for the caller to say so.
+        listed in the robot's ``missing_meshes``, for the caller to say so. The description's Gazebo
+        sensor blocks become the robot's ``sensors`` (:mod:`thorvald_sim.sensors`); what is not
+        simulated and what is refused is in ``sensor_blocks`` and ``sensor_problems``, for the
+        caller to say so too. The robot spawns whatever its sensor blocks hold.
         """
         if not name:
             raise SpawnError("a robot needs a name")
@@ -87,6 +98,17 @@ class Simulation:
         except DescriptionError as e:
             raise SpawnError(f"{name}: {e}") from None
         robot.missing_meshes = missing
+        blocks = read_sensor_blocks(urdf)
+        robot.sensor_blocks = blocks
+        robot.sensors, robot.sensor_problems = build_sensors(
+            blocks.sensors,
+            robot,
+            urdf,
+            seed=self.seed,
+            dt=self.dt,
+            gravity=self.world.gravity,
+            datum=description.datum or self.datum,
+        )
         self.robots[name] = robot
         return robot
 

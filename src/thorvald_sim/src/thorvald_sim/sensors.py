@@ -1,0 +1,477 @@
+"""The robot's sensors in the pybullet world: what each measures, when, with its noise. No ROS here.
+
+A :class:`Sensor` is made from a :class:`thorvald_sim.sensor_blocks.SensorSpec` and the robot it is
+on. It is mounted on the link its Gazebo block names: pybullet merges links fixed to each other
+(``URDF_MERGE_FIXED_LINKS``), so the mount is the nearest link pybullet kept (the base, or the
+child of a moving joint) and the fixed joints' origins between, composed with the block's
+``<pose>``.
+
+Measurements are taken at the sensor's rate on simulated time (``due``): the next instant is the
+last one plus the period, so 40 Hz gives 40 measurements per simulated second whatever the physics
+rate; a sensor nobody reads is not measured at all (the simulator node asks ``due`` only while
+the sensor has subscribers) and starts again from the instant it is read again.
+
+* Lidars cast one ray per beam with ``rayTestBatch`` from ``range_min`` to ``range_max`` along the
+  beam (as Gazebo's ray sensor, whose rays start at the minimum range), so they see the world, the
+  other robots and the robot's own body beyond range_min; no hit is ``inf``. Gaussian noise on
+  every hit.
+* The IMU reads the mount's orientation in the world (its ``rpyOffset`` applied), its angular
+  velocity and its proper acceleration (the mean acceleration since the last reading, minus
+  gravity: +9.81 m/s^2 up at rest), in the sensor's axes; gaussianNoise on every component.
+* The GNSS reads the mount's position and velocity in the world through hector's error model (an
+  offset, a Gauss-Markov drift and white noise per axis) and converts them with hector's
+  convention: world x is the reference heading's direction (compass, 0 = north), y 90 degrees
+  to its left, latitude and longitude from the WGS84 radii at the reference latitude.
+* Cameras render with pybullet's software renderer (no display): the camera looks along its
+  frame's +x with +z up, as Gazebo's; depth cameras also give metric depth.
+* p3d reports a link's pose and twist in the world (or in another link), with its offsets.
+
+Every sensor's noise comes from its own generator, seeded from the simulation's seed and the
+robot's and sensor's names, so a run can be repeated.
+"""
+
+import math
+import time
+import zlib
+from dataclasses import dataclass
+from typing import Dict, List, Optional, Tuple
+
+import numpy as np
+import pybullet as p
+
+from .description import ParentJoint, link_tree
+from .sensor_blocks import (
+    CameraConfig,
+    Datum,
+    GpsConfig,
+    ImuConfig,
+    P3dConfig,
+    RayConfig,
+    SensorSpec,
+    gps_reference,
+)
+
+Vec3 = Tuple[float, float, float]
+Quat = Tuple[float, float, float, float]
+Transform = Tuple[Vec3, Quat]
+IDENTITY: Transform = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+
+RAY_BATCH = 16384  # pybullet's largest rayTestBatch (MAX_RAY_INTERSECTION_BATCH_SIZE)
+WGS84_A = 6378137.0  # [m] equatorial radius
+WGS84_F = 1.0 / 298.257223563
+WGS84_E2 = 2 * WGS84_F - WGS84_F * WGS84_F
+
+
+class MountError(Exception):
+    """A sensor's link cannot be found on the loaded robot."""
+
+
+def _transform(xyz: Vec3, rpy: Vec3) -> Transform:
+    return tuple(xyz), tuple(p.getQuaternionFromEuler(rpy))
+
+
+def _compose(a: Transform, b: Transform) -> Transform:
+    pos, quat = p.multiplyTransforms(a[0], a[1], b[0], b[1])
+    return tuple(pos), tuple(quat)
+
+
+def _rotate(quat: Quat, v) -> np.ndarray:
+    m = np.asarray(p.getMatrixFromQuaternion(quat)).reshape(3, 3)
+    return m @ np.asarray(v, dtype=float)
+
+
+def _unrotate(quat: Quat, v) -> np.ndarray:
+    m = np.asarray(p.getMatrixFromQuaternion(quat)).reshape(3, 3)
+    return m.T @ np.asarray(v, dtype=float)
+
+
+def find_mount(
+    tree: Dict[str, ParentJoint], joint_index: Dict[str, int], link: str, offset: Transform = IDENTITY
+) -> Tuple[int, Transform]:
+    """(pybullet link index, sensor frame in that link's frame) of a sensor on ``link``: up the fixed
+    joints to the nearest link pybullet kept (-1: the base)."""
+    chain = offset
+    seen = set()
+    while link in tree:
+        joint = tree[link]
+        if joint.type != "fixed" and joint.joint in joint_index:
+            return joint_index[joint.joint], chain
+        if link in seen:
+            raise MountError(f"link {link} is in a loop of joints")
+        seen.add(link)
+        chain = _compose(_transform(joint.origin.xyz, joint.origin.rpy), chain)
+        link = joint.parent
+    return -1, chain
+
+
+def noise_generator(seed: int, robot: str, sensor: str) -> np.random.Generator:
+    """A sensor's own random generator: the same seed, robot and sensor give the same noise."""
+    return np.random.default_rng([int(seed) & 0xFFFFFFFF, zlib.crc32(robot.encode()), zlib.crc32(sensor.encode())])
+
+
+class Schedule:
+    """The instants of a rate [Hz] on simulated time; rate 0: every physics step."""
+
+    def __init__(self, rate: float):
+        self.period = 1.0 / rate if rate > 0 else 0.0
+        self.next: Optional[float] = None
+
+    def due(self, now: float, dt: float) -> bool:
+        if self.period == 0.0:
+            return True
+        if self.next is None or self.next < now - self.period - dt:
+            self.next = now  # first reading, or again after nobody read it: from now on
+        if now + dt / 2 < self.next:
+            return False
+        self.next += self.period
+        return True
+
+    def pause(self) -> None:
+        self.next = None
+
+
+@dataclass
+class Cost:
+    """What a sensor has cost: CPU [s] (this thread's) and readings, since the node last looked."""
+
+    cpu: float = 0.0
+    readings: int = 0
+
+    def take(self) -> Tuple[float, int]:
+        out = (self.cpu, self.readings)
+        self.cpu, self.readings = 0.0, 0
+        return out
+
+
+class Sensor:
+    """One sensor on one robot. ``read(now)`` measures and returns a reading (see the subclasses)."""
+
+    def __init__(self, spec: SensorSpec, robot, mount: Tuple[int, Transform], rng: np.random.Generator, dt: float):
+        self.spec = spec
+        self.robot = robot
+        self.link_index, self.offset = mount
+        self.rng = rng
+        self.dt = dt
+        self.schedule = Schedule(spec.rate)
+        self.cost = Cost()
+
+    @property
+    def client(self) -> int:
+        return self.robot.client
+
+    def due(self, now: float) -> bool:
+        return self.schedule.due(now, self.dt)
+
+    def pose(self) -> Transform:
+        """The sensor frame in the world."""
+        pos, quat, _, _, _ = self.robot.link_state(self.link_index)
+        return _compose((pos, quat), self.offset)
+
+    def kinematics(self) -> Tuple[Transform, np.ndarray, np.ndarray]:
+        """(sensor frame in the world, its point's velocity, angular velocity), world axes."""
+        pos, quat, com, v, w = self.robot.link_state(self.link_index)
+        frame = _compose((pos, quat), self.offset)
+        r = np.asarray(frame[0]) - np.asarray(com)
+        w = np.asarray(w)
+        return frame, np.asarray(v) + np.cross(w, r), w
+
+    def read(self, now: float):
+        start = time.thread_time()
+        try:
+            return self.measure(now)
+        finally:
+            self.cost.cpu += time.thread_time() - start
+            self.cost.readings += 1
+
+    def measure(self, now: float):
+        raise NotImplementedError
+
+
+# ---------------------------------------------------------------------------------------------
+# Lidars
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Scan:
+    """ranges [m] (vertical samples x horizontal samples, inf: no return) and the beams' unit
+    directions in the sensor frame (same shape + 3)."""
+
+    ranges: np.ndarray
+    directions: np.ndarray
+
+
+class Lidar(Sensor):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        c: RayConfig = self.spec.config
+        h = np.linspace(c.min_angle, c.max_angle, c.samples) if c.samples > 1 else np.array([c.min_angle])
+        if c.vertical_samples > 1:
+            v = np.linspace(c.vertical_min_angle, c.vertical_max_angle, c.vertical_samples)
+        else:
+            v = np.array([c.vertical_min_angle])
+        vv, hh = np.meshgrid(v, h, indexing="ij")
+        self.directions = np.stack([np.cos(vv) * np.cos(hh), np.cos(vv) * np.sin(hh), np.sin(vv)], axis=-1)
+
+    def measure(self, now: float) -> Scan:
+        c: RayConfig = self.spec.config
+        origin, quat = self.pose()
+        m = np.asarray(p.getMatrixFromQuaternion(quat)).reshape(3, 3)
+        d = self.directions.reshape(-1, 3) @ m.T
+        o = np.asarray(origin)
+        starts = o + d * c.range_min
+        ends = o + d * c.range_max
+        fractions = np.empty(len(d))
+        for k in range(0, len(d), RAY_BATCH):
+            hits = p.rayTestBatch(
+                starts[k : k + RAY_BATCH].tolist(), ends[k : k + RAY_BATCH].tolist(), physicsClientId=self.client
+            )
+            fractions[k : k + len(hits)] = [h[2] if h[0] >= 0 else np.inf for h in hits]
+        ranges = c.range_min + fractions * (c.range_max - c.range_min)
+        if c.noise_stddev > 0 or c.noise_mean != 0:
+            hit = np.isfinite(ranges)
+            ranges[hit] += (
+                self.rng.normal(c.noise_mean, c.noise_stddev, int(hit.sum())) if c.noise_stddev > 0 else c.noise_mean
+            )
+        return Scan(ranges.reshape(self.directions.shape[:2]), self.directions)
+
+
+# ---------------------------------------------------------------------------------------------
+# IMU
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ImuReading:
+    orientation: Quat  # x, y, z, w: the sensor frame in the world
+    angular_velocity: Vec3  # [rad/s] sensor axes
+    linear_acceleration: Vec3  # [m/s^2] sensor axes, proper acceleration (gravity included)
+    noise: float
+
+
+class Imu(Sensor):
+    def __init__(self, *args, gravity: float = 9.81, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.gravity = gravity
+        self.last: Optional[Tuple[float, np.ndarray]] = None  # (time, velocity) of the last reading
+        self.offset_rotation = p.getQuaternionFromEuler(self.spec.config.rpy_offset)
+
+    def measure(self, now: float) -> ImuReading:
+        c: ImuConfig = self.spec.config
+        (_, quat), v, w = self.kinematics()
+        if self.last is not None and now - self.last[0] > 1e-9 and now - self.last[0] < 1.0:
+            a = (v - self.last[1]) / (now - self.last[0])
+        else:
+            a = np.zeros(3)
+        self.last = (now, v)
+        proper = a + np.array([0.0, 0.0, self.gravity])
+        acc = _unrotate(quat, proper)
+        gyro = _unrotate(quat, w)
+        _, orientation = p.multiplyTransforms((0, 0, 0), self.offset_rotation, (0, 0, 0), quat)
+        if c.noise > 0:
+            acc = acc + self.rng.normal(0.0, c.noise, 3)
+            gyro = gyro + self.rng.normal(0.0, c.noise, 3)
+            q = np.asarray(orientation) + self.rng.normal(0.0, c.noise, 4)
+            orientation = tuple(q / np.linalg.norm(q))
+        return ImuReading(tuple(orientation), tuple(gyro), tuple(acc), c.noise)
+
+
+# ---------------------------------------------------------------------------------------------
+# GNSS
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class GnssReading:
+    latitude: float  # [deg]
+    longitude: float  # [deg]
+    altitude: float  # [m]
+    velocity: Vec3  # [m/s] in hector's axes (x the reference heading, y left of it, z up)
+    covariance: Vec3  # diagonal [m^2]: drift^2 + noise^2 per axis (hector's)
+
+
+class _ErrorProcess:
+    """hector's SensorModel on three axes: value + offset + drift (Gauss-Markov) + white noise."""
+
+    def __init__(self, model, rng: np.random.Generator):
+        self.model = model
+        self.rng = rng
+        self.drift = np.zeros(3)
+
+    def __call__(self, value: np.ndarray, dt: float) -> np.ndarray:
+        m = self.model
+        sigma, freq = np.asarray(m.drift), np.asarray(m.drift_frequency)
+        if dt > 0 and np.any(sigma > 0):
+            decay = np.exp(-dt * freq)
+            self.drift = decay * self.drift + sigma * np.sqrt(1.0 - decay * decay) * self.rng.standard_normal(3)
+        noise = np.asarray(m.gaussian_noise)
+        white = noise * self.rng.standard_normal(3) if np.any(noise > 0) else 0.0
+        return value + np.asarray(m.offset) + self.drift + white
+
+
+class Gnss(Sensor):
+    def __init__(self, *args, datum: Optional[Datum] = None, **kwargs):
+        super().__init__(*args, **kwargs)
+        c: GpsConfig = self.spec.config
+        self.reference = gps_reference(self.spec, datum)
+        lat = math.radians(self.reference[0])
+        temp = 1.0 / (1.0 - WGS84_E2 * math.sin(lat) ** 2)
+        prime_vertical = WGS84_A * math.sqrt(temp)
+        self.radius_north = prime_vertical * (1.0 - WGS84_E2) * temp
+        self.radius_east = prime_vertical * math.cos(lat)
+        self.position_error = _ErrorProcess(c.position, self.rng)
+        self.velocity_error = _ErrorProcess(c.velocity, self.rng)
+        self.last_time: Optional[float] = None
+
+    def measure(self, now: float) -> GnssReading:
+        c: GpsConfig = self.spec.config
+        (pos, _), v, _ = self.kinematics()
+        dt = 0.0 if self.last_time is None else now - self.last_time
+        self.last_time = now
+        velocity = self.velocity_error(v, dt)
+        # hector: a velocity drift integrates into the position's drift
+        self.position_error.drift = self.position_error.drift + dt * self.velocity_error.drift
+        position = self.position_error(np.asarray(pos), dt)
+        lat0, lon0, heading_deg, alt0 = self.reference
+        h = math.radians(heading_deg)
+        x, y, z = position
+        latitude = lat0 + (math.cos(h) * x + math.sin(h) * y) / self.radius_north * 180.0 / math.pi
+        longitude = lon0 - (-math.sin(h) * x + math.cos(h) * y) / self.radius_east * 180.0 / math.pi
+        vel = (
+            math.cos(h) * velocity[0] + math.sin(h) * velocity[1],
+            -math.sin(h) * velocity[0] + math.cos(h) * velocity[1],
+            float(velocity[2]),
+        )
+        covariance = tuple(float(d * d + n * n) for d, n in zip(c.position.drift, c.position.gaussian_noise))
+        return GnssReading(latitude, longitude, alt0 + z, vel, covariance)
+
+
+# ---------------------------------------------------------------------------------------------
+# Cameras
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Frame:
+    """A camera frame: the image (height x width x channels, uint8) and, for depth cameras, the depth
+    along the optical axis [m] (float32, NaN outside the point cloud's cutoffs)."""
+
+    image: np.ndarray
+    depth: Optional[np.ndarray]
+
+
+class Camera(Sensor):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        c: CameraConfig = self.spec.config
+        vfov = 2.0 * math.atan(math.tan(c.horizontal_fov / 2.0) * c.height / c.width)
+        self.projection = p.computeProjectionMatrixFOV(math.degrees(vfov), c.width / c.height, c.near, c.far)
+
+    def measure(self, now: float) -> Frame:
+        c: CameraConfig = self.spec.config
+        eye, quat = self.pose()
+        forward = _rotate(quat, (1.0, 0.0, 0.0))
+        up = _rotate(quat, (0.0, 0.0, 1.0))
+        view = p.computeViewMatrix(eye, (np.asarray(eye) + forward).tolist(), up.tolist())
+        flags = p.ER_NO_SEGMENTATION_MASK
+        _, _, rgba, depth_buffer, _ = p.getCameraImage(
+            c.width, c.height, view, self.projection, renderer=p.ER_TINY_RENDERER, flags=flags,
+            physicsClientId=self.client,
+        )  # fmt: skip
+        rgba = np.asarray(rgba, dtype=np.uint8).reshape(c.height, c.width, 4)
+        if c.channels == 1:
+            image = np.asarray(rgba[:, :, :3].mean(axis=2), dtype=np.uint8)[:, :, None]
+        elif c.encoding == "bgr8":
+            image = np.ascontiguousarray(rgba[:, :, 2::-1])
+        else:
+            image = np.ascontiguousarray(rgba[:, :, :3])
+        depth = None
+        if c.depth:
+            d = np.asarray(depth_buffer, dtype=np.float64).reshape(c.height, c.width)
+            # OpenGL's depth buffer to metric depth along the optical axis
+            depth = (c.far * c.near / (c.far - (c.far - c.near) * d)).astype(np.float32)
+            depth[(depth < c.point_cloud_cutoff) | (depth > c.point_cloud_cutoff_max) | (d >= 1.0)] = np.nan
+        return Frame(image, depth)
+
+
+def depth_to_points(depth: np.ndarray, config: CameraConfig) -> np.ndarray:
+    """An organised cloud (height x width x 3) in the optical frame (z forward, x right, y down) from a
+    depth image, with gazebo_ros's intrinsics (focal length from horizontal_fov, centre (w+1)/2, (h+1)/2)."""
+    h, w = depth.shape
+    f = config.focal_length
+    u = np.arange(w, dtype=np.float32) + 1.0 - (w + 1) / 2.0
+    v = np.arange(h, dtype=np.float32) + 1.0 - (h + 1) / 2.0
+    x = depth * (u[None, :] / f)
+    y = depth * (v[:, None] / f)
+    return np.stack([x, y, depth], axis=-1)
+
+
+# ---------------------------------------------------------------------------------------------
+# p3d (ground truth of a link)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LinkTruth:
+    position: Vec3
+    orientation: Quat
+    linear: Vec3  # [m/s] in the reference frame's axes
+    angular: Vec3  # [rad/s]
+    noise: float
+
+
+class P3d(Sensor):
+    def __init__(self, *args, reference: Optional["Sensor"] = None, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.reference = reference  # a Sensor-like mount of the reference link; None: the world
+        c: P3dConfig = self.spec.config
+        self.offset_rotation = p.getQuaternionFromEuler(c.rpy_offsets)
+
+    def measure(self, now: float) -> LinkTruth:
+        c: P3dConfig = self.spec.config
+        (pos, quat), v, w = self.kinematics()
+        if self.reference is not None:
+            (rpos, rquat), rv, rw = self.reference.kinematics()
+            relative = np.asarray(pos) - np.asarray(rpos)
+            v = _unrotate(rquat, v - rv - np.cross(rw, relative))
+            w = _unrotate(rquat, w - rw)
+            inv = p.invertTransform(rpos, rquat)
+            pos, quat = p.multiplyTransforms(*inv, pos, quat)
+        position = np.asarray(pos) + np.asarray(c.xyz_offsets)
+        _, orientation = p.multiplyTransforms((0, 0, 0), self.offset_rotation, (0, 0, 0), quat)
+        if c.noise > 0:
+            position = position + self.rng.normal(0.0, c.noise, 3)
+            v = v + self.rng.normal(0.0, c.noise, 3)
+            w = w + self.rng.normal(0.0, c.noise, 3)
+        return LinkTruth(tuple(position), tuple(orientation), tuple(v), tuple(w), c.noise)
+
+
+# ---------------------------------------------------------------------------------------------
+# A robot's sensors
+# ---------------------------------------------------------------------------------------------
+KINDS = {"laser": Lidar, "multilayer": Lidar, "imu": Imu, "gps": Gnss, "camera": Camera, "depth": Camera, "p3d": P3d}
+
+
+def build_sensors(
+    specs, robot, urdf: str, *, seed: int = 0, dt: float, gravity: float = 9.81, datum: Optional[Datum] = None
+) -> Tuple[List[Sensor], List[str]]:
+    """The robot's sensors from its specs; (sensors, problems) where a problem names a sensor whose
+    link cannot be mounted (the others are kept)."""
+    tree = link_tree(urdf)
+    sensors, problems = [], []
+    for spec in specs:
+        try:
+            mount = find_mount(tree, robot.joint_index, spec.link, _transform(spec.pose.xyz, spec.pose.rpy))
+        except MountError as e:
+            problems.append(f"{spec.describe()}: {e}")
+            continue
+        rng = noise_generator(seed, robot.name, spec.name + "@" + spec.link)
+        extra = {}
+        if spec.kind == "imu":
+            extra["gravity"] = gravity
+        elif spec.kind == "gps":
+            extra["datum"] = datum
+        elif spec.kind == "p3d" and spec.config.reference_frame != "world":
+            ref = spec.config.reference_frame
+            if ref not in tree and ref != _root(tree, spec.link):
+                problems.append(f"{spec.describe()}: frameName {ref!r} is neither world nor a link of the robot")
+                continue
+            extra["reference"] = Sensor(spec, robot, find_mount(tree, robot.joint_index, ref), rng, dt)
+        sensors.append(KINDS[spec.kind](spec, robot, mount, rng, dt, **extra))
+    return sensors, problems
+
+
+def _root(tree: Dict[str, ParentJoint], link: str) -> str:
+    while link in tree:
+        link = tree[link].parent
+    return link
