@@ -23,6 +23,7 @@ import xacro
 import yaml
 
 from .config import load_robot_config, parse_robot_config
+from .datum import load_datum
 from .errors import ConfigError, ThorvaldModelError
 from .frames import normalize_tf_prefix
 from .resources import package_folder
@@ -111,20 +112,34 @@ def _eval_extension(text: str, _original: Callable[[str], Any]) -> Any:
     return _original(text)
 
 
+def _load_datum(filename: str) -> Dict[str, float]:
+    """The datum file (model.launch's datum_file) for the simulator block; its ConfigError carried out
+    of xacro like a robot file's."""
+    try:
+        datum = load_datum(xacro.abs_filename_spec(filename))
+    except ConfigError as e:
+        raise RobotConfigAbort(e) from None
+    xacro.all_includes.append(filename)
+    return {"latitude": datum.latitude, "longitude": datum.longitude, "yaw": datum.yaw, "altitude": datum.altitude}
+
+
 @contextlib.contextmanager
 def shared_loader() -> Iterator[None]:
     """Within the block, xacro's load_yaml() is :func:`_load_yaml`, $(arg) needs no roslaunch, and
-    ``normalize_tf_prefix()`` is the one rule of :mod:`thorvald_model.frames` for the xacro."""
+    ``normalize_tf_prefix()`` is the one rule of :mod:`thorvald_model.frames` for the xacro, and
+    ``load_datum()`` reads a datum file through :mod:`thorvald_model.datum`."""
     previous_load = xacro.global_symbols.get("load_yaml")
     previous_extension = xacro.eval_extension
     xacro.global_symbols["load_yaml"] = _load_yaml
     xacro.global_symbols["normalize_tf_prefix"] = normalize_tf_prefix
+    xacro.global_symbols["load_datum"] = _load_datum
     xacro.eval_extension = functools.partial(_eval_extension, _original=previous_extension)
     try:
         yield
     finally:
         xacro.global_symbols["load_yaml"] = previous_load
         xacro.global_symbols.pop("normalize_tf_prefix", None)
+        xacro.global_symbols.pop("load_datum", None)
         xacro.eval_extension = previous_extension
 
 
@@ -143,7 +158,7 @@ def xacro_args(
         "tf_prefix": tf_prefix,
         "robot_config": os.path.abspath(robot_config),
         "model_extras": os.path.abspath(model_extras) if model_extras else "",
-        "datum_file": datum_file,
+        "datum_file": os.path.abspath(datum_file) if datum_file else "",
     }
 
 

@@ -13,7 +13,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Callable, Dict, Iterable, Optional, Tuple
 
-from .sensor_blocks import Datum
+from thorvald_model.datum import Datum
 
 
 class DescriptionError(Exception):
@@ -155,11 +155,11 @@ def parse_description(xml: str) -> RobotDescription:
 
 
 def _datum(element) -> Optional[Datum]:
-    """The generator's ``<datum latitude= longitude= heading= [altitude=]/>`` (robot_localization's datum:
-    degrees, degrees, ENU yaw [rad])."""
+    """The generator's ``<datum latitude= longitude= yaw= altitude=/>`` (from the robot_localization datum
+    file model.launch was given: degrees, degrees, ENU yaw of the world's x axis [rad], metres)."""
     if element is None:
         return None
-    values = [_float(element.get(k), f"datum {k}") for k in ("latitude", "longitude", "heading", "altitude")]
+    values = [_float(element.get(k), f"datum {k}") for k in ("latitude", "longitude", "yaw", "altitude")]
     if not -90.0 <= values[0] <= 90.0:
         raise DescriptionError(f"datum latitude: {values[0]!r} must be in [-90, 90]")
     return Datum(*values)

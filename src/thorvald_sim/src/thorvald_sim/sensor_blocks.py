@@ -37,6 +37,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, replace
 from typing import Dict, List, Optional, Tuple
 
+from thorvald_model.datum import Datum
+
 Vec3 = Tuple[float, float, float]
 
 # What the plugins do with frameName (see resolve_frame)
@@ -686,22 +688,6 @@ def resolve_topic(spec: SensorSpec, role: str, namespace: str) -> str:
     ns = namespace if spec.namespace is None else spec.namespace
     ns = "/" + ns.strip("/") if ns.strip("/") else ""
     return f"{ns}/{topic}"
-
-
-@dataclass(frozen=True)
-class Datum:
-    """A robot_localization datum: ``datum: [latitude, longitude, heading]`` (heading [rad], ENU yaw of the
-    world's x axis, 0 = east). hector's referenceHeading is the compass heading of x [deg, 0 = north,
-    clockwise], so ``heading_deg = 90 - degrees(yaw)``."""
-
-    latitude: float
-    longitude: float
-    yaw: float = 0.0
-    altitude: float = 0.0
-
-    @property
-    def reference(self) -> Tuple[float, float, float, float]:
-        return (self.latitude, self.longitude, 90.0 - math.degrees(self.yaw), self.altitude)
 
 
 def gps_reference(spec: SensorSpec, datum: Optional[Datum]) -> Tuple[float, float, float, float]:

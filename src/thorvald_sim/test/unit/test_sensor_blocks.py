@@ -2,9 +2,12 @@
 defaults, topics, frames, and a broken block refusing that sensor only."""
 
 import math
+import os
 
 import pytest
 
+from thorvald_model.description import generate_urdf
+from thorvald_sim.description import parse_description
 from thorvald_sim.sensor_blocks import (
     HECTOR_REFERENCE,
     Datum,
@@ -225,3 +228,13 @@ def test_a_sensor_on_a_link_the_description_lacks_is_refused():
     blocks = read_sensor_blocks(robot(LIDAR.replace('reference="lidar_link"', 'reference="elsewhere"')))
     assert not blocks.sensors
     assert blocks.refused[0].link == "elsewhere" and "not in the description" in blocks.refused[0].rule
+
+
+def test_the_generators_datum_is_the_descriptions(tmp_path):
+    here = os.path.dirname(os.path.abspath(__file__))
+    std = os.path.join(here, "..", "..", "..", "thorvald_model", "config", "thorvald_ii_4wd4ws_std",
+                       "thorvald_ii_4wd4ws_std.yaml")  # fmt: skip
+    path = tmp_path / "datum.yaml"
+    path.write_text("datum: [53.268642, -0.524509, 0.0]\naltitude: 12.5\n")
+    assert parse_description(generate_urdf(std, datum_file=str(path))).datum == Datum(53.268642, -0.524509, 0.0, 12.5)
+    assert parse_description(generate_urdf(std)).datum is None
