@@ -43,7 +43,8 @@ Vec3 = Tuple[float, float, float]
 
 # What the plugins do with frameName (see resolve_frame)
 FRAME_TF_RESOLVE = "tf_resolve"  # gazebo_ros laser, gpu_laser, block_laser, camera, openni, p3d, gps sensor
-FRAME_AS_IS = "as_is"  # imu_sensor, imu, hector gps, velodyne: the name as written
+FRAME_AS_IS = "as_is"  # imu_sensor, imu, hector gps: the name as written
+FRAME_NAMESPACE_FIRST = "namespace_first"  # velodyne: tf::resolve with the namespace, else tf_prefix
 
 LASER_PLUGINS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")
 MULTILAYER_PLUGINS = (
@@ -386,7 +387,8 @@ def _multilayer(found: _Found) -> SensorSpec:
         noise = plugin.number("gaussianNoise", config.noise_stddev, rule=NON_NEGATIVE[0], check=NON_NEGATIVE[1])
         config = replace(config, range_min=max(rmin, config.range_min), range_max=min(rmax, config.range_max),
                          noise_stddev=noise)  # fmt: skip
-        topic, frame, rule = plugin.text("topicName", "/points"), plugin.text("frameName", "/world"), FRAME_AS_IS
+        topic, frame = plugin.text("topicName", "/points"), plugin.text("frameName", "/world")
+        rule = FRAME_NAMESPACE_FIRST
     else:  # gazebo_ros_block_laser
         noise = plugin.number("gaussianNoise", config.noise_stddev, rule=NON_NEGATIVE[0], check=NON_NEGATIVE[1])
         config = replace(config, noise_stddev=noise)
@@ -670,11 +672,15 @@ def resolve_frame(spec: SensorSpec, tf_prefix: str, namespace: str) -> str:
     FRAME_TF_RESOLVE (gazebo_ros laser, camera, p3d ...): the ``tf_prefix`` parameter found from the
     robot's namespace, or else the namespace without its trailing slash, as prefix (tf::resolve).
     So a frameName of ``hokuyo`` in robot ``thorvald_001`` is ``thorvald_001/hokuyo``; write
-    ``/thorvald_001/hokuyo`` for a name to be kept as it is. FRAME_AS_IS: as written.
+    ``/thorvald_001/hokuyo`` for a name to be kept as it is. FRAME_NAMESPACE_FIRST (velodyne): the
+    same with the namespace before tf_prefix. FRAME_AS_IS (imu_sensor, imu, hector gps): as written.
     """
     if spec.frame_rule == FRAME_AS_IS:
         return spec.frame
-    prefix = tf_prefix if tf_prefix else namespace.strip("/")
+    if spec.frame_rule == FRAME_NAMESPACE_FIRST:  # velodyne_gazebo_plugins: the namespace wins over tf_prefix
+        prefix = namespace.strip("/") or tf_prefix
+    else:
+        prefix = tf_prefix if tf_prefix else namespace.strip("/")
     return tf_resolve(prefix, spec.frame)
 
 

@@ -475,3 +475,52 @@ def _root(tree: Dict[str, ParentJoint], link: str) -> str:
     while link in tree:
         link = tree[link].parent
     return link
+
+
+# ---------------------------------------------------------------------------------------------
+# What sensors cost (the simulator's /diagnostics)
+# ---------------------------------------------------------------------------------------------
+OK, WARN = 0, 1  # diagnostic_msgs/DiagnosticStatus levels
+
+
+@dataclass(frozen=True)
+class SensorUse:
+    """One sensor over a window of the simulation."""
+
+    name: str  # how the report names it, e.g. "laser front_lidar (/thorvald_001/scan)"
+    rate: float  # [Hz] asked; 0: every physics step
+    cpu: float  # [s] of CPU spent measuring and publishing in the window
+    readings: int
+
+
+def sensor_report(
+    uses: List[SensorUse], simulated: float, physics_rate: float, real_time_factor: float
+) -> Tuple[int, str, Dict[str, str]]:
+    """(level, message, values) of the sensors read in a window of ``simulated`` seconds.
+
+    A sensor cannot hold its rate when it is asked for more than the physics rate (it is measured
+    once a step at most), or when its own CPU per simulated second exceeds the wall time a
+    simulated second may take at the real-time factor asked (it alone slows the simulation below
+    it); either is a warning naming the sensor.
+    """
+    values: Dict[str, str] = {}
+    late = []
+    total = 0.0
+    for use in uses:
+        cpu = use.cpu / simulated if simulated > 0 else 0.0
+        rate = use.readings / simulated if simulated > 0 else 0.0
+        asked = use.rate if use.rate > 0 else physics_rate
+        total += cpu
+        values[f"{use.name}: CPU per simulated second [s]"] = f"{cpu:.5f}"
+        values[f"{use.name}: rate [Hz]"] = f"{rate:.1f} of {asked:g}"
+        if use.rate > physics_rate:
+            late.append(f"{use.name} asks {use.rate:g} Hz, above the physics rate {physics_rate:g} Hz")
+        elif real_time_factor > 0 and cpu * real_time_factor > 1.0:
+            late.append(
+                f"{use.name} costs {cpu:.2f} s of CPU per simulated second: not at {real_time_factor:g} x real time"
+            )
+    n = len(uses)
+    message = f"{n} sensor{'' if n == 1 else 's'} read, {total:.4f} s CPU per simulated second"
+    if late:
+        return WARN, message + "; cannot hold its rate: " + "; ".join(late), values
+    return OK, message, values

@@ -19,8 +19,18 @@ Private parameters:
 ``~tyre_contact_width``   width of the wheels' collision discs [m] (0.01; see robot.py)
 ``~paused``               start paused (false)
 ``~diagnostics_rate``     /diagnostics per wall second [Hz] (1; 0: none): the real-time factor
-                          reached and the CPU the simulation costs (see ``publish_performance``)
+                          reached and the CPU the simulation costs (see ``publish_performance``),
+                          and per robot what each sensor read costs
+``~seed``                 seed of every sensor's noise (0): the same seed repeats a run's noise
+``~datum_file``           a robot_localization datum file: the GNSS reference of robots whose
+                          description has neither a reference nor a datum of its own (none)
 ========================  ================================================================
+
+Sensors: the Gazebo sensor blocks of each robot's description (``model_extras``) are simulated
+with the gazebo_ros plugins' topics, frames and parameters (:mod:`thorvald_sim.sensor_blocks`,
+:mod:`thorvald_sim.sensors`, :mod:`thorvald_sim.sensor_io`), each only while somebody subscribes
+to it; a sensor or plugin that is not simulated is logged once at spawn with its name and link,
+and a broken block refuses that sensor with the link, the element path and the rule.
 
 Per robot, in its namespace: subscribes the command topic (``base_state``, as the original plugin,
 or base_driver's ``drive_commands`` with measured drives); publishes ``odometry/gazebo``
@@ -52,6 +62,7 @@ from tf2_msgs.msg import TFMessage
 from thorvald_base import conversions
 from thorvald_base.publishing import NonBlockingPublisher
 from thorvald_model import ConfigError
+from thorvald_model.datum import load_datum
 from thorvald_msgs.msg import BaseState
 from thorvald_msgs.srv import (
     DeleteRobot,
@@ -63,6 +74,8 @@ from thorvald_msgs.srv import (
 )
 
 from .robot import Pose2D
+from .sensor_io import RobotSensors
+from .sensors import sensor_report
 from .simulation import Camera, PerformanceMeter, Simulation, SpawnError, save_png
 from .world import load_world, resolve_world
 
@@ -123,6 +136,7 @@ class RobotIO:
         self.sub = rospy.Subscriber(ns + command_topic, BaseState, self.on_command, queue_size=1)
         self.passive = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
         self.passive_names = [info.name for _, info in robot.passive] + [s.joint for _, s in robot.springs]
+        self.sensors = RobotSensors(robot.sensors, namespace or "/")
 
     def on_command(self, msg):
         n = len(self.robot.wheels)
@@ -202,6 +216,7 @@ class RobotIO:
         self.sub.unregister()
         for pub in (self.odom_pub, self.joint_pub, self.drive_pub):
             pub.unregister()
+        self.sensors.close()
 
 
 class SimulatorNode:
@@ -220,8 +235,13 @@ class SimulatorNode:
         tyre = positive("tyre_contact_width", 0.01)
         self.paused = bool(rospy.get_param("~paused", False))
         diagnostics_rate = positive("diagnostics_rate", 1.0, allow_zero=True)
+        seed = rospy.get_param("~seed", 0)
+        if isinstance(seed, bool) or not isinstance(seed, int):
+            raise ParameterError(f"~seed: {seed!r}: must be a whole number")
+        datum_file = str(rospy.get_param("~datum_file", "") or "")
+        datum = load_datum(datum_file) if datum_file else None
         self.client = p.connect(p.GUI if self.gui else p.DIRECT)
-        self.sim = Simulation(self.client, world, physics_rate, tyre)
+        self.sim = Simulation(self.client, world, physics_rate, tyre, seed=seed, datum=datum)
         self.lock = threading.RLock()
         self.missing_meshes_said = set()  # mesh URIs warned about: once each, however many robots name them
         self.io = {}
@@ -287,6 +307,7 @@ class SimulatorNode:
                         mesh.reason,
                         mesh.link,
                     )
+            self.say_sensors(req.model_name, robot)
             topic = req.command_topic or robot.description.command_topic
             tf = self.default_tf if req.publish_tf < 0 else bool(req.publish_tf)
             self.io[req.model_name] = RobotIO(self, robot, req.robot_namespace, topic, tf)
@@ -294,6 +315,26 @@ class SimulatorNode:
         message = f"spawned {req.model_name} in {req.robot_namespace or '/'} at ({req.x:g}, {req.y:g}), {kind}"
         rospy.loginfo("simulator: %s", message)
         return SpawnRobotResponse(True, message)
+
+    @staticmethod
+    def say_sensors(name, robot):
+        """The robot's sensors at spawn: what is simulated, what is not (once, by name and link), and
+        what is refused (the link, the element path and the rule)."""
+        blocks = robot.sensor_blocks
+        for other in blocks.unsupported:
+            rospy.logwarn(
+                "simulator: %s: %s%s not simulated", name, other.what, f" on link {other.link}" if other.link else ""
+            )
+        for refused in blocks.refused:
+            rospy.logerr("simulator: %s: sensor refused: %s", name, refused)
+        for problem in robot.sensor_problems:
+            rospy.logerr("simulator: %s: sensor refused: %s", name, problem)
+        if robot.sensors:
+            rospy.loginfo(
+                "simulator: %s: sensors %s",
+                name,
+                ", ".join(f"{s.spec.kind} {s.spec.name} ({s.spec.rate:g} Hz)" for s in robot.sensors),
+            )
 
     def srv_delete(self, req):
         with self.lock:
@@ -391,6 +432,8 @@ class SimulatorNode:
         if self.drives.due(now):
             for io in self.io.values():
                 io.publish_drives(stamp)
+        for io in self.io.values():
+            io.sensors.step(now)
 
     def publish_performance(self, wall: float) -> None:
         """/diagnostics once per ~diagnostics_rate period of wall time: the real-time factor reached, and
@@ -400,10 +443,18 @@ class SimulatorNode:
         if not self.meter.due(wall):
             return
         perf = self.meter.sample(wall, self.sim.time, time.process_time(), self.sim.solver_cpu)
-        if perf is None or not self.diagnostics.get_num_connections():
+        if perf is None:
+            return
+        asked = self.real_time_factor
+        with self.lock:  # each window's sensor costs are taken whether anybody reads them or not
+            sensor_reports = [
+                (name, sensor_report(io.sensors.uses(), perf.simulated, 1.0 / self.sim.dt, asked))
+                for name, io in self.io.items()
+                if io.sensors.ios
+            ]
+        if not self.diagnostics.get_num_connections():
             return
         rtf = perf.real_time_factor
-        asked = self.real_time_factor
         level = DiagnosticStatus.OK
         if self.paused:
             message = "paused"
@@ -423,11 +474,14 @@ class SimulatorNode:
             "solver CPU per simulated second [s]": f"{perf.per_simulated_second(perf.solver_cpu):.5f}",
             "CPU share [cores]": f"{perf.cpu / perf.wall:.3f}",
         }
-        msg = DiagnosticArray(
-            status=[
-                conversions.diagnostic_status(rospy.get_name() + ": simulation", "pybullet", level, message, values)
-            ]
-        )
+        statuses = [
+            conversions.diagnostic_status(rospy.get_name() + ": simulation", "pybullet", level, message, values)
+        ]
+        statuses += [
+            conversions.diagnostic_status(f"{rospy.get_name()}: sensors of {name}", name, *report)
+            for name, report in sensor_reports
+        ]
+        msg = DiagnosticArray(status=statuses)
         msg.header.stamp = rospy.Time.from_sec(self.sim.time)
         self.diagnostics.publish(msg)
 

@@ -142,7 +142,9 @@ def test_multilayer_lidars():
     assert (s.config.vertical_samples, s.config.range_min, s.config.range_max) == (16, 0.9, 30.0)
     assert s.config.noise_stddev == 0.008
     assert resolve_topic(s, "points", "/r1") == "/r1/scan"
-    assert resolve_frame(s, "", "/r1") == "lidar_link"  # velodyne's plugin keeps frameName as written
+    # velodyne's plugin: tf::resolve with the namespace first, then the tf_prefix parameter
+    assert resolve_frame(s, "other", "/r1") == "r1/lidar_link"
+    assert resolve_frame(s, "other", "/") == "other/lidar_link"
 
 
 def test_imu_sensor_and_imu_model_plugin():

@@ -13,7 +13,17 @@ import pytest
 
 from thorvald_sim.robot import Pose2D
 from thorvald_sim.sensor_blocks import Datum
-from thorvald_sim.sensors import WGS84_A, WGS84_E2, Schedule, depth_to_points, noise_generator
+from thorvald_sim.sensors import (
+    OK,
+    WARN,
+    WGS84_A,
+    WGS84_E2,
+    Schedule,
+    SensorUse,
+    depth_to_points,
+    noise_generator,
+    sensor_report,
+)
 from thorvald_sim.simulation import Simulation
 from thorvald_sim.world import parse_world
 
@@ -273,3 +283,19 @@ def test_sensor_blocks_do_not_stop_a_robot_from_spawning(world):
     robot = sim.spawn("probe", robot_urdf(broken, IMU), Pose2D())
     assert [s.spec.kind for s in robot.sensors] == ["imu"]
     assert robot.sensor_blocks.refused[0].path.endswith("samples")
+
+
+def test_the_sensor_report_names_a_sensor_that_cannot_hold_its_rate():
+    level, message, values = sensor_report([SensorUse("laser a (/scan)", 40.0, 0.02, 80)], 2.0, 240.0, 1.0)
+    assert level == OK and "1 sensor read" in message
+    assert values["laser a (/scan): rate [Hz]"] == "40.0 of 40"
+    assert values["laser a (/scan): CPU per simulated second [s]"] == "0.01000"
+    # a camera costing 1.5 s of CPU per simulated second cannot run at real time
+    level, message, _ = sensor_report([SensorUse("camera c (/img)", 30.0, 3.0, 60)], 2.0, 240.0, 1.0)
+    assert level == WARN and "camera c (/img) costs 1.50 s" in message
+    # ... but can at a real-time factor of 0.5, and at "as fast as possible" nothing is late
+    assert sensor_report([SensorUse("camera c (/img)", 30.0, 3.0, 60)], 2.0, 240.0, 0.5)[0] == OK
+    assert sensor_report([SensorUse("camera c (/img)", 30.0, 3.0, 60)], 2.0, 240.0, 0.0)[0] == OK
+    # a rate above the physics rate is measured once a step at most
+    level, message, _ = sensor_report([SensorUse("imu i (/imu)", 1000.0, 0.01, 480)], 2.0, 240.0, 0.0)
+    assert level == WARN and "above the physics rate" in message
