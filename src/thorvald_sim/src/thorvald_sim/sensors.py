@@ -210,20 +210,20 @@ class Lidar(Sensor):
             v = np.array([c.vertical_min_angle])
         vv, hh = np.meshgrid(v, h, indexing="ij")
         self.directions = np.stack([np.cos(vv) * np.cos(hh), np.cos(vv) * np.sin(hh), np.sin(vv)], axis=-1)
+        self._flat = self.directions.reshape(-1, 3)
 
     def measure(self, now: float) -> Scan:
         c: RayConfig = self.spec.config
         origin, quat = self.pose()
         m = np.asarray(p.getMatrixFromQuaternion(quat)).reshape(3, 3)
-        d = self.directions.reshape(-1, 3) @ m.T
+        d = self._flat @ m.T
         o = np.asarray(origin)
+        # pybullet takes the arrays as they are (a list of them costs a fifth of the rays' time)
         starts = o + d * c.range_min
         ends = o + d * c.range_max
         fractions = np.empty(len(d))
         for k in range(0, len(d), RAY_BATCH):
-            hits = p.rayTestBatch(
-                starts[k : k + RAY_BATCH].tolist(), ends[k : k + RAY_BATCH].tolist(), physicsClientId=self.client
-            )
+            hits = p.rayTestBatch(starts[k : k + RAY_BATCH], ends[k : k + RAY_BATCH], physicsClientId=self.client)
             fractions[k : k + len(hits)] = [h[2] if h[0] >= 0 else np.inf for h in hits]
         ranges = c.range_min + fractions * (c.range_max - c.range_min)
         if c.noise_stddev > 0 or c.noise_mean != 0:
