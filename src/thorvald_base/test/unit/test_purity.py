@@ -22,6 +22,7 @@ NOT_PURE = {
     "thorvald_model.place_robot": "a node",
     "thorvald_sim.simulator_node": "a node",
     "thorvald_sim.spawn_robot": "a node",
+    "thorvald_sim.sensor_io": "the simulator node's sensor topics",
     "thorvald_teleop.joy_node": "a node",
     "thorvald_teleop.teleop_node": "a node",
     "thorvald_teleop.keyboard_node": "a node",
@@ -33,6 +34,7 @@ NOT_PURE = {
     "thorvald_sim.scene": "the simulator's physics (pybullet)",
     "thorvald_sim.robot": "the simulator's physics (pybullet)",
     "thorvald_sim.simulation": "the simulator's physics (pybullet)",
+    "thorvald_sim.sensors": "the simulator's sensors (pybullet)",
 }
 # Modules that import ROS only when a function runs, on purpose; every other module (the base
 # handles among them) imports none even inside a function.
