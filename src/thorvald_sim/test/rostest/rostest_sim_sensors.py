@@ -63,6 +63,9 @@ class SimSensorRatesTest(unittest.TestCase):
         cls.rosout = rospy.Subscriber("/rosout", Log, lambda m: cls.said.append(m.msg), queue_size=1000)
         cls.scan = Latest(ROBOT + "/scan", LaserScan)
         cls.scan.wait()
+        # the obstacles are spawned by nodes of their own: wait until each is in the world
+        for name in ("wall", "post", "red_box"):
+            Latest(f"/obstacles/{name}/odometry/gazebo").wait()
         sim_sleep(0.5)
 
     def test_rates_held_on_simulated_time(self):
@@ -94,7 +97,10 @@ class SimSensorsTest(SimSensorRatesTest):
         self.assertTrue(math.isinf(scan.ranges[left]), f"beam at +120 degrees reads {scan.ranges[left]}")
 
     def test_3d_lidar_rings(self):
-        cloud = Latest(ROBOT + "/velodyne_points", PointCloud2).wait()
+        clouds = Latest(ROBOT + "/velodyne_points", PointCloud2)
+        clouds.wait()
+        sim_sleep(0.3)  # a cloud of the world with every obstacle in it
+        cloud = clouds.get()
         self.assertEqual(cloud.header.frame_id, "thorvald_001/velodyne")
         self.assertEqual([f.name for f in cloud.fields], ["x", "y", "z", "intensity", "ring", "time"])
         dtype = np.dtype(
