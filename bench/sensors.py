@@ -30,7 +30,7 @@ import time
 
 import numpy as np
 from base_driver import Processes, cpu_seconds, free_port, start_master
-from sim import children, cmdline
+from sim import children, cmdline, fleet_launch, stop_launch
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 STD = os.path.join(ROOT, "src", "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
@@ -105,18 +105,7 @@ def node_case(n: int, seconds: float, port: int, subscribe, sensors: bool = True
 
     env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
     extras = f'<arg name="model_extras" value="{EXTRAS}"/>' if sensors else ""
-    robots = "\n".join(
-        f'  <include file="$(find thorvald_sim)/launch/robot.launch"><arg name="robot_name" value="r{k}"/>'
-        f'<arg name="x" value="{SPACING * k}"/>{extras}</include>'
-        for k in range(n)
-    )
-    launch = tempfile.NamedTemporaryFile("w", suffix=".launch", delete=False)
-    launch.write(
-        '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'
-        '<arg name="real_time_factor" value="0"/><arg name="output" value="log"/></include>\n'
-        f"{robots}\n</launch>\n"
-    )
-    launch.close()
+    launch = fleet_launch([(SPACING * k, 0) for k in range(n)], robot_args=extras)
     clock = {"t": None}
     sub = rospy.Subscriber("/clock", Clock, lambda m: clock.__setitem__("t", m.clock.to_sec()))
     per_sensor = {}
@@ -166,13 +155,7 @@ def node_case(n: int, seconds: float, port: int, subscribe, sensors: bool = True
             r.unregister()
         sub.unregister()
         diagnostics.unregister()
-        proc.send_signal(signal.SIGINT)
-        try:
-            proc.wait(timeout=60)
-        except subprocess.TimeoutExpired:
-            for pid in children(proc.pid):
-                os.kill(pid, signal.SIGKILL)
-            proc.kill()
+        stop_launch(proc)
         os.unlink(launch.name)
         output.close()
 

@@ -110,19 +110,7 @@ def node(n: int, seconds: float, port: int, clock_rate: float):
     from rosgraph_msgs.msg import Clock  # noqa: PLC0415
 
     env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
-    robots = "\n".join(
-        f'  <include file="$(find thorvald_sim)/launch/robot.launch"><arg name="robot_name" value="r{k}"/>'
-        f'<arg name="x" value="{grid(k)[0]}"/><arg name="y" value="{grid(k)[1]}"/></include>'
-        for k in range(n)
-    )
-    launch = tempfile.NamedTemporaryFile("w", suffix=".launch", delete=False)
-    launch.write(
-        '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'
-        '<arg name="real_time_factor" value="0"/><arg name="output" value="log"/>'
-        f'<arg name="clock_rate" value="{clock_rate:g}"/></include>\n'
-        f"{robots}\n</launch>\n"
-    )
-    launch.close()
+    launch = fleet_launch([grid(k) for k in range(n)], f'<arg name="clock_rate" value="{clock_rate:g}"/>')
     clock = {"t": None}
     sub = rospy.Subscriber("/clock", Clock, lambda m: clock.__setitem__("t", m.clock.to_sec()))
     solver = []  # the simulator's own figure per window: pybullet's solver's CPU [s] per simulated second
@@ -204,17 +192,40 @@ def node(n: int, seconds: float, port: int, clock_rate: float):
         diagnostics.unregister()
         for pub in pubs:
             pub.unregister()
-        proc.send_signal(signal.SIGINT)
-        try:
-            proc.wait(timeout=60)
-        except subprocess.TimeoutExpired:
-            for pid in children(proc.pid):
-                os.kill(pid, signal.SIGKILL)
-            proc.kill()
+        stop_launch(proc)
         os.unlink(launch.name)
         output.close()
         if measured:
             os.unlink(output.name)  # kept when the case failed
+
+
+def fleet_launch(positions, simulator_args: str = "", robot_args: str = ""):
+    """A launch file (closed, for the caller to remove): simulator.launch as fast as it can, and
+    robot.launch r0, r1, ... at positions [(x, y)], each with robot_args (launch XML) added."""
+    robots = "\n".join(
+        f'  <include file="$(find thorvald_sim)/launch/robot.launch"><arg name="robot_name" value="r{k}"/>'
+        f'<arg name="x" value="{x}"/><arg name="y" value="{y}"/>{robot_args}</include>'
+        for k, (x, y) in enumerate(positions)
+    )
+    launch = tempfile.NamedTemporaryFile("w", suffix=".launch", delete=False)
+    launch.write(
+        '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'
+        '<arg name="real_time_factor" value="0"/><arg name="output" value="log"/>'
+        f"{simulator_args}</include>\n{robots}\n</launch>\n"
+    )
+    launch.close()
+    return launch
+
+
+def stop_launch(proc) -> None:
+    """roslaunch stopped as Ctrl-C stops it, its nodes killed if it has not gone within a minute."""
+    proc.send_signal(signal.SIGINT)
+    try:
+        proc.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        for pid in children(proc.pid):
+            os.kill(pid, signal.SIGKILL)
+        proc.kill()
 
 
 def children(pid):

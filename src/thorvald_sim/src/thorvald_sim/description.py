@@ -13,7 +13,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Callable, Dict, Iterable, Optional, Tuple
 
-from thorvald_model.datum import Datum
+from thorvald_model.datum import Datum, parse_datum
+from thorvald_model.errors import ConfigError
 
 
 class DescriptionError(Exception):
@@ -156,13 +157,15 @@ def parse_description(xml: str) -> RobotDescription:
 
 def _datum(element) -> Optional[Datum]:
     """The generator's ``<datum latitude= longitude= yaw= altitude=/>`` (from the robot_localization datum
-    file model.launch was given: degrees, degrees, ENU yaw of the world's x axis [rad], metres)."""
+    file model.launch was given: degrees, degrees, ENU yaw of the world's x axis [rad], metres), checked
+    by the datum file's own rules."""
     if element is None:
         return None
     values = [_float(element.get(k), f"datum {k}") for k in ("latitude", "longitude", "yaw", "altitude")]
-    if not -90.0 <= values[0] <= 90.0:
-        raise DescriptionError(f"datum latitude: {values[0]!r} must be in [-90, 90]")
-    return Datum(*values)
+    try:
+        return parse_datum({"datum": values[:3], "altitude": values[3]}, "the simulator block's <datum>")
+    except ConfigError as e:
+        raise DescriptionError(str(e)) from None
 
 
 @dataclass(frozen=True)

@@ -223,6 +223,13 @@ class _Element:
         found = self.e.find(tag)
         return None if found is None else _Element(found, f"{self.path}/{tag}")
 
+    def required(self, tag: str, rule: str) -> "_Element":
+        """The child element, or BlockError naming its path: ``missing: <rule>``."""
+        found = self.child(tag)
+        if found is None:
+            raise BlockError(f"{self.path}/{tag}", f"missing: {rule}")
+        return found
+
     def has(self, tag: str) -> bool:
         return self.e.find(tag) is not None
 
@@ -303,15 +310,9 @@ def _namespace(plugin: _Element) -> Optional[str]:
 # Sensors (<gazebo reference="LINK"><sensor>)
 # ---------------------------------------------------------------------------------------------
 def _ray(sensor: _Element) -> RayConfig:
-    ray = sensor.child("ray")
-    if ray is None:
-        raise BlockError(f"{sensor.path}/ray", "missing: a ray sensor needs <ray>")
-    scan = ray.child("scan")
-    if scan is None:
-        raise BlockError(f"{ray.path}/scan", "missing: a ray sensor needs <scan>")
-    horizontal = scan.child("horizontal")
-    if horizontal is None:
-        raise BlockError(f"{scan.path}/horizontal", "missing: a ray sensor needs <horizontal>")
+    ray = sensor.required("ray", "a ray sensor needs <ray>")
+    scan = ray.required("scan", "a ray sensor needs <scan>")
+    horizontal = scan.required("horizontal", "a ray sensor needs <horizontal>")
     samples = horizontal.count("samples")
     min_angle = horizontal.number("min_angle", 0.0)
     max_angle = horizontal.number("max_angle", 0.0)
@@ -325,9 +326,7 @@ def _ray(sensor: _Element) -> RayConfig:
             raise BlockError(f"{vertical.path}/max_angle", f"{v_max!r} must be >= min_angle ({v_min!r})")
     else:
         v_samples, v_min, v_max = 1, 0.0, 0.0
-    rng = ray.child("range")
-    if rng is None:
-        raise BlockError(f"{ray.path}/range", "missing: a ray sensor needs <range> (min, max)")
+    rng = ray.required("range", "a ray sensor needs <range> (min, max)")
     range_min = rng.number("min", rule=NON_NEGATIVE[0], check=NON_NEGATIVE[1])
     range_max = rng.number("max", rule=f"must be > min ({range_min!r})", check=lambda v: v > range_min)
     resolution = rng.number("resolution", 0.0, rule=NON_NEGATIVE[0], check=NON_NEGATIVE[1])
@@ -410,8 +409,7 @@ def _multilayer(found: _Found) -> SensorSpec:
 
 def _imu_sensor(found: _Found) -> SensorSpec:
     sensor, plugin, link, name, filename, rate = _unpack(found)
-    if not plugin.has("frameName"):
-        raise BlockError(f"{plugin.path}/frameName", "missing: gazebo_ros_imu_sensor needs it (it refuses to load)")
+    plugin.required("frameName", "gazebo_ros_imu_sensor needs it (it refuses to load)")
     # the plugin's own updateRateHZ (default 1 Hz) paces the messages, within the sensor's update_rate
     plugin_rate = _rate(plugin, "updateRateHZ", 1.0)
     effective = min(r for r in (plugin_rate, rate) if r > 0) if (plugin_rate > 0 or rate > 0) else 0.0
@@ -442,12 +440,8 @@ def _gps_sensor(found: _Found) -> SensorSpec:
 
 def _camera(found: _Found, depth: bool) -> SensorSpec:
     sensor, plugin, link, name, filename, rate = _unpack(found)
-    camera = sensor.child("camera")
-    if camera is None:
-        raise BlockError(f"{sensor.path}/camera", "missing: a camera sensor needs <camera>")
-    image = camera.child("image")
-    if image is None:
-        raise BlockError(f"{camera.path}/image", "missing: a camera needs <image> (width, height)")
+    camera = sensor.required("camera", "a camera sensor needs <camera>")
+    image = camera.required("image", "a camera needs <image> (width, height)")
     fmt = image.text("format", "R8G8B8")
     if fmt not in IMAGE_FORMATS:
         raise BlockError(f"{image.path}/format", f"{fmt!r} must be one of {', '.join(IMAGE_FORMATS)}")
@@ -516,11 +510,9 @@ class _NotSimulated(Exception):
 # Model plugins (<gazebo><plugin>)
 # ---------------------------------------------------------------------------------------------
 def _model_imu(plugin: _Element, root_link: str, filename: str, name: str) -> SensorSpec:
-    if not plugin.has("bodyName"):
-        raise BlockError(f"{plugin.path}/bodyName", "missing: gazebo_ros_imu needs the link to measure")
+    plugin.required("bodyName", "gazebo_ros_imu needs the link to measure")
     body = plugin.text("bodyName")
-    if not plugin.has("topicName"):
-        raise BlockError(f"{plugin.path}/topicName", "missing: gazebo_ros_imu needs it")
+    plugin.required("topicName", "gazebo_ros_imu needs it")
     rate = _rate(plugin, "updateRate", 0.0) if plugin.has("updateRate") else _rate(plugin, "update_rate", 0.0)
     config = ImuConfig(
         plugin.number("gaussianNoise", 0.0, rule=NON_NEGATIVE[0], check=NON_NEGATIVE[1]), plugin.vector("rpyOffset")
@@ -577,10 +569,8 @@ def _hector_gps(plugin: _Element, root_link: str, filename: str, name: str) -> S
 
 
 def _p3d(plugin: _Element, root_link: str, filename: str, name: str) -> SensorSpec:
-    if not plugin.has("bodyName"):
-        raise BlockError(f"{plugin.path}/bodyName", "missing: gazebo_ros_p3d needs the link to report")
-    if not plugin.has("topicName"):
-        raise BlockError(f"{plugin.path}/topicName", "missing: gazebo_ros_p3d needs it")
+    plugin.required("bodyName", "gazebo_ros_p3d needs the link to report")
+    plugin.required("topicName", "gazebo_ros_p3d needs it")
     body = plugin.text("bodyName")
     frame = plugin.text("frameName", "world")
     reference = "world" if frame.strip("/") in ("world", "map", "") else frame.strip("/")

@@ -140,15 +140,19 @@ class SensorIO:
         data = np.zeros(len(points), dtype=LIDAR_DTYPE)
         data["x"], data["y"], data["z"] = points[:, 0], points[:, 1], points[:, 2]
         data["ring"] = rings
+        yield "points", self.cloud(stamp, data[None, :], LIDAR_FIELDS, dense=True)
+
+    def cloud(self, stamp, data: np.ndarray, fields, dense: bool) -> PointCloud2:
+        """A PointCloud2 of a structured array of points (height x width), little-endian."""
         msg = self.header(PointCloud2(), stamp)
-        msg.height, msg.width = 1, len(points)
-        msg.fields = LIDAR_FIELDS
+        msg.height, msg.width = data.shape
+        msg.fields = fields
         msg.is_bigendian = False
-        msg.point_step = LIDAR_DTYPE.itemsize
+        msg.point_step = data.dtype.itemsize
         msg.row_step = msg.point_step * msg.width
-        msg.is_dense = True
+        msg.is_dense = dense
         msg.data = data.tobytes()
-        yield "points", msg
+        return msg
 
     def _imu(self, r, stamp, wanted):
         msg = self.header(Imu(), stamp)
@@ -208,15 +212,7 @@ class SensorIO:
             if rgb.shape[2] == 1:
                 rgb = np.repeat(rgb, 3, axis=2)
             data["rgb"] = (rgb[..., 0] << 16) | (rgb[..., 1] << 8) | rgb[..., 2]
-            cloud = self.header(PointCloud2(), stamp)
-            cloud.height, cloud.width = c.height, c.width
-            cloud.fields = CAMERA_FIELDS
-            cloud.is_bigendian = False
-            cloud.point_step = CAMERA_DTYPE.itemsize
-            cloud.row_step = cloud.point_step * c.width
-            cloud.is_dense = False
-            cloud.data = data.tobytes()
-            yield "points", cloud
+            yield "points", self.cloud(stamp, data, CAMERA_FIELDS, dense=False)
 
     _depth = _camera
 

@@ -31,7 +31,6 @@ robot's and sensor's names, so a run can be repeated.
 """
 
 import math
-import time
 import zlib
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Tuple
@@ -130,19 +129,6 @@ class Schedule:
         self.next = None
 
 
-@dataclass
-class Cost:
-    """What a sensor has cost: CPU [s] (this thread's) and readings, since the node last looked."""
-
-    cpu: float = 0.0
-    readings: int = 0
-
-    def take(self) -> Tuple[float, int]:
-        out = (self.cpu, self.readings)
-        self.cpu, self.readings = 0.0, 0
-        return out
-
-
 class Sensor:
     """One sensor on one robot. ``read(now)`` measures and returns a reading (see the subclasses)."""
 
@@ -153,7 +139,6 @@ class Sensor:
         self.rng = rng
         self.dt = dt
         self.schedule = Schedule(spec.rate)
-        self.cost = Cost()
 
     @property
     def client(self) -> int:
@@ -176,14 +161,7 @@ class Sensor:
         return frame, np.asarray(v) + np.cross(w, r), w
 
     def read(self, now: float):
-        start = time.thread_time()
-        try:
-            return self.measure(now)
-        finally:
-            self.cost.cpu += time.thread_time() - start
-            self.cost.readings += 1
-
-    def measure(self, now: float):
+        """A measurement at simulated time now [s] (what it costs is the caller's to count)."""
         raise NotImplementedError
 
 
@@ -212,7 +190,7 @@ class Lidar(Sensor):
         self.directions = np.stack([np.cos(vv) * np.cos(hh), np.cos(vv) * np.sin(hh), np.sin(vv)], axis=-1)
         self._flat = self.directions.reshape(-1, 3)
 
-    def measure(self, now: float) -> Scan:
+    def read(self, now: float) -> Scan:
         c: RayConfig = self.spec.config
         origin, quat = self.pose()
         m = np.asarray(p.getMatrixFromQuaternion(quat)).reshape(3, 3)
@@ -252,7 +230,7 @@ class Imu(Sensor):
         self.last: Optional[Tuple[float, np.ndarray]] = None  # (time, velocity) of the last reading
         self.offset_rotation = p.getQuaternionFromEuler(self.spec.config.rpy_offset)
 
-    def measure(self, now: float) -> ImuReading:
+    def read(self, now: float) -> ImuReading:
         c: ImuConfig = self.spec.config
         (_, quat), v, w = self.kinematics()
         if self.last is not None and now - self.last[0] > 1e-9 and now - self.last[0] < 1.0:
@@ -317,7 +295,7 @@ class Gnss(Sensor):
         self.velocity_error = _ErrorProcess(c.velocity, self.rng)
         self.last_time: Optional[float] = None
 
-    def measure(self, now: float) -> GnssReading:
+    def read(self, now: float) -> GnssReading:
         c: GpsConfig = self.spec.config
         (pos, _), v, _ = self.kinematics()
         dt = 0.0 if self.last_time is None else now - self.last_time
@@ -359,7 +337,7 @@ class Camera(Sensor):
         vfov = 2.0 * math.atan(math.tan(c.horizontal_fov / 2.0) * c.height / c.width)
         self.projection = p.computeProjectionMatrixFOV(math.degrees(vfov), c.width / c.height, c.near, c.far)
 
-    def measure(self, now: float) -> Frame:
+    def read(self, now: float) -> Frame:
         c: CameraConfig = self.spec.config
         eye, quat = self.pose()
         forward = _rotate(quat, (1.0, 0.0, 0.0))
@@ -417,7 +395,7 @@ class P3d(Sensor):
         c: P3dConfig = self.spec.config
         self.offset_rotation = p.getQuaternionFromEuler(c.rpy_offsets)
 
-    def measure(self, now: float) -> LinkTruth:
+    def read(self, now: float) -> LinkTruth:
         c: P3dConfig = self.spec.config
         (pos, quat), v, w = self.kinematics()
         if self.reference is not None:
