@@ -14,12 +14,12 @@ states), next to the paper's figures; Figures 8 and 9 are written as PNG.
 import argparse
 import os
 import shutil
-import socket
 import subprocess
 import sys
 import time
 
 from thorvald_model import ConfigError, load_robot_config
+from thorvald_model.ports import free_port
 
 TARGET_DISTANCE_ERROR = 0.5  # [%] for lsq (the paper: 1.0 %)
 TARGET_END_POINT = 1.0  # [m] for lsq (the paper: 2.2 m)
@@ -65,12 +65,6 @@ def robot_file(args) -> str:
             f"no example robot {args.robot!r}; the examples are: {' '.join(sorted(os.listdir(config_dir)))}"
         )
     return path
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def drive(args, model: str, bag: str) -> float:

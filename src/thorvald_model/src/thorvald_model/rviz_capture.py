@@ -10,7 +10,6 @@ import contextlib
 import copy
 import os
 import signal
-import socket
 import subprocess
 import tempfile
 import time
@@ -23,6 +22,7 @@ from PIL import Image, ImageGrab
 
 from .config import RobotConfig
 from .description import package_file
+from .ports import free_port
 
 BACKGROUND = (48, 48, 48)  # model.rviz's background colour
 
@@ -77,12 +77,6 @@ def write_rviz_config(path: str, view: View, width: int, height: int, fixed_fram
     }
     with open(path, "w") as f:
         yaml.safe_dump(cfg, f, default_flow_style=False)
-
-
-def free_port() -> int:
-    with contextlib.closing(socket.socket(socket.AF_INET, socket.SOCK_STREAM)) as s:
-        s.bind(("localhost", 0))
-        return s.getsockname()[1]
 
 
 def free_display() -> int:

@@ -1,31 +1,27 @@
 """What the workspace's tests share (pytest suites, rostest nodes and benchmarks alike).
 
-* :func:`free_port`: a TCP port nobody listens on, for a ROS master of a test's own;
+* :func:`free_port`: a TCP port nobody listens on, for a ROS master of a test's own (outside the
+  ephemeral range, so no node takes it meanwhile: thorvald_model.ports);
 * :func:`poll`: wait for a condition with a deadline, failing with what was awaited;
 * :func:`ros_env`, :func:`ros_master`: a private ROS master (its own port and ROS_HOME);
 * :class:`Launch`: roslaunch in a session of its own, stopped with everything it started;
 * :func:`stop_group`, :func:`processes_naming`, :func:`kill_processes_naming`: ending processes.
 
 Nothing here sleeps to let something happen: every wait polls until a deadline, because the tests
-run on a machine shared with other work. Pure standard library (and the ROS command-line tools the
-functions start).
+run on a machine shared with other work. Standard library and thorvald_model.ports (and the ROS
+command-line tools the functions start).
 """
 
 import os
 import signal
-import socket
 import subprocess
 import time
 import xmlrpc.client
 from typing import Callable, Dict, Iterator, List, Optional, Sequence, Union
 
+from thorvald_model.ports import free_port
+
 START = 30.0  # [s] for a process to come up on a busy machine
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def poll(predicate: Callable, timeout: float, what: Union[str, Callable[[], str]], interval: float = 0.02):
