@@ -1,39 +1,108 @@
-"""The simulator's world: a small YAML file of ground, friction patches, hills and heating-pipe rails.
+"""The simulator's world: a small YAML file of ground, friction patches, hills, heating-pipe rails,
+objects, crop rows, polytunnels, walls and uneven ground.
 
 The simulator node's ``~world`` parameter names a shipped world (``flat``, ``tarmac_gravel``,
-``slope``, ``greenhouse``: the files in this package's ``worlds`` folder) or gives a path. A world file
-has these top-level keys (lengths [m], angles [rad], frictions are pybullet's per-body
-coefficients, which pybullet multiplies with the wheel's; the simulator's wheels have friction 1.0):
+``slope``, ``greenhouse``, ``crop_rows``, ``polytunnel``, ``vineyard``: the files in this package's
+``worlds`` folder) or gives a path. A world file has these top-level keys (lengths [m], angles
+[rad], masses [kg]; frictions are pybullet's per-body coefficients, which pybullet multiplies with
+the wheel's; the simulator's wheels have friction 1.0). Defaults in brackets; a key without one is
+required. Every section's entries are numbered from 0 without gaps (``object0``, ``object1``, ...).
+A colour, ``rgba``, is a list of 3 or 4 numbers in [0, 1] (red, green, blue and alpha, 1 if left out).
 
 ``gravity``
-    [m/s^2], default 9.81.
+    [m/s^2] (9.81).
 ``ground``
-    one mapping: ``lateral_friction``, ``rolling_friction``, ``spinning_friction``, ``restitution``.
+    one mapping: ``lateral_friction`` (0.9), ``rolling_friction`` (0), ``spinning_friction`` (0),
+    ``restitution`` (0), ``rgba`` (tarmac grey ``[0.35, 0.35, 0.37, 1]``: the colour it is drawn in).
 ``patches``
-    ``patch0``, ``patch1``, ...: rectangles of another friction lying on the ground (gravel, ice),
-    centred at ``x``, ``y``, ``size_x`` by ``size_y``, turned by ``yaw``.
+    ``patch0``, ...: rectangles of another friction lying on the ground (gravel, ice), centred at
+    ``x``, ``y``, ``size_x`` by ``size_y``, turned by ``yaw`` (0); ``lateral_friction``,
+    ``rolling_friction`` (0), ``spinning_friction`` (0).
 ``slopes``
-    ``slope0``, ...: hills along their own x axis: a ramp up at ``angle``, a flat top of
-    ``top_length`` at ``height``, a ramp down at ``angle``; ``x``, ``y`` is the centre of the
-    footprint, ``width`` its size across.
+    ``slope0``, ...: hills along their own x axis: a ramp up at ``angle`` (at most 1.2), a flat top
+    of ``top_length`` (0) at ``height``, a ramp down at ``angle``; ``x``, ``y`` is the centre of the
+    footprint, ``yaw`` (0) the direction uphill, ``width`` its size across; frictions (0.9, 0, 0).
 ``rails``
     ``rail0``, ...: pairs of parallel heating pipes as in greenhouses (the paper's Figure 2a robot
     rides them): ``x``, ``y`` is the point between the pipes at the middle of their ``length``,
-    ``yaw`` the direction they run in, ``gauge`` the distance between the pipe centres.
+    ``yaw`` (0) the direction they run in, ``gauge`` (0.55) the distance between the pipe centres,
+    ``height`` (0.1) of the centres, ``radius`` (0.0255); frictions (0.8, 0, 0).
+``objects``
+    ``object0``, ...: single bodies. ``shape``: ``box`` (``size_x``, ``size_y``, ``size_z``),
+    ``cylinder`` (``radius``, ``length`` along its own z), ``sphere`` (``radius``) or ``mesh``
+    (``file``: an OBJ or STL file, a relative path from the world file's folder; ``scale`` (1)).
+    ``x``, ``y``; ``z``: of the centre (a mesh's origin) above the ground under it (default: resting
+    upright on it, half its height up; a mesh's origin on it); ``roll``, ``pitch``, ``yaw`` (0).
+    ``mass`` (0: static; above 0 it falls, slides and can be pushed, without drag as the robots);
+    ``rgba`` (wood brown); frictions (0.8, 0, 0), ``restitution`` (0).
+``rows``
+    ``row0``, ...: crop rows made from a few numbers. The first row starts at ``x``, ``y`` and runs
+    ``length`` along ``yaw`` (0); ``count`` (1) rows, each ``spacing`` (0.75) left of the previous
+    one (+y for yaw 0). Plants every ``plant_spacing`` (0.3) from the start to the end of each row:
+    ``plant``: ``cylinder`` (default: a column of ``plant_radius`` (0.1) and ``plant_height`` (0.4))
+    or ``sphere`` (a ball of ``plant_radius`` whose top is at ``plant_height``, on a stem a tenth of
+    its radius thick: a lettuce, a cabbage, a vine's canopy); each plant is missing with
+    ``gap_probability`` (alias ``gaps``; 0), and moved by up to ``jitter`` (0) along and across its
+    row, from a random generator seeded by ``seed`` (0): the same numbers give the same plants.
+    Plants stand on the ground under them (hills and height fields too). ``rgba`` (leaf green);
+    frictions (0.5, 0, 0). At most 100 000 plants an entry.
+``polytunnels``
+    ``polytunnel0``, ...: a Haygrove-type tunnel on level ground (its floor is the ground height at
+    its centre): ``x``, ``y`` the centre of the floor, ``yaw`` (0) the direction it runs in,
+    ``length``, ``width`` (8) between the leg rows, ``height`` (4) of the ridge, ``leg_height``
+    (2): straight legs up to there, then an arch (a half ellipse; a half circle when
+    ``height - leg_height`` is ``width / 2``); a hoop every ``hoop_spacing`` (2) from end to end
+    (the spacing is shrunk to fit a whole number), joined by a ridge pole and a pole along each leg
+    row; every tube ``tube`` (0.05) thick. ``crop``: ``table_tops`` (default), ``ground_beds`` or
+    ``none``; ``tables`` (4) rows of tables (or beds) across the tunnel, evenly spread (centres
+    ``width / tables`` apart, the outer ones half that from the legs), ``table_width`` (0.4),
+    ending ``end_gap`` (1.5) inside each end. A table-top: a trough 0.2 deep whose top is at
+    ``table_height`` (1.1), on pairs of legs every ``leg_spacing`` (1.8); a ground bed: a bed of
+    soil ``bed_height`` (0.2) high. Strawberry plants every ``plant_spacing`` (0.25) on both: balls
+    of 0.3 ``table_width`` radius with their centres half a radius above the top, red berries
+    hanging over the sides (drawn only). Frictions (0.5, 0, 0).
+``walls``
+    ``wall0``, ...: boxes standing on the ground: ``x``, ``y`` the centre, ``yaw`` (0) the
+    direction the wall runs in, ``length``, ``height`` (2), ``thickness`` (0.2); ``rgba`` (concrete);
+    frictions (0.8, 0, 0). The foot is at the lowest ground along the wall.
+``height_field``
+    one mapping: uneven ground replacing the ground plane (beyond its edges there is no ground);
+    friction and colour are the ground's. ``x``, ``y`` (0) its centre, ``size_x``, ``size_y``.
+    Either a grey-scale image, ``image`` (a PNG, 8 or 16 bits; colours are taken by luminance;
+    relative paths from the world file's folder; its first row is the +y edge, as a map, and its
+    pixels are the grid's points), black at ``min_height`` (0) and white at ``max_height`` (1); or a
+    grid every ``resolution`` (0.2). Either way, added: random bumps up to ``amplitude`` (0) high
+    and deep, ``feature_length`` (1) apart (value noise from ``seed`` (0)), and ruts along the
+    field's x axis ``rut_depth`` (0) deep, ``rut_width`` (0.3) wide, every ``rut_spacing`` (1.5)
+    across (the field's centre line is half-way between two ruts). Within ``flat_radius`` (2) of the
+    origin, where robots spawn at z = 0 by default, the field is 0 (its grid points out to one
+    cell's diagonal more), rising to full height over the next metre. At most 1 000 000 grid
+    points. Patches, hills and rails stay at z = 0.
 ``description``
     free text.
 
 Validation is the robot configuration's (:mod:`thorvald_model.schema`): every problem is collected
-with its dotted key path, value and rule, and raised together in one :class:`ConfigError`.
+with its dotted key path, value and rule, and raised together in one :class:`ConfigError`. Beyond
+each key's own rule: a rail's radius below its height and its gauge above two radii; an object has
+its shape's dimensions and no other shape's, and its mesh file exists; a sphere plant's height is
+at least its radius; a tunnel's height is above its leg height, its end gaps leave the tables a
+length, its tables leave aisles between them (``tables * table_width < width``) and its plants
+stay under its roof; a height field with an image takes no ``resolution``, one without takes no
+``min_height`` or ``max_height``, its ``max_height`` is above its ``min_height`` and its
+``rut_width`` at most its ``rut_spacing``.
 
-Pure: no pybullet, no rospy, no messages (the scene is built by :mod:`thorvald_sim.scene`).
+Pure: no pybullet, no rospy, no messages (the scene is built by :mod:`thorvald_sim.scene`); the
+plants' positions, the tunnels' geometry and the heights of the ground are computed here, so tests
+check them without a physics engine.
 """
 
+import functools
 import glob
 import math
 import os
-from dataclasses import dataclass
-from typing import Any, List, Mapping, Tuple
+import random
+from dataclasses import dataclass, replace
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 from thorvald_model.errors import MISSING, ConfigError, Problem
 from thorvald_model.resources import package_folder
@@ -43,6 +112,7 @@ from thorvald_model.schema import (
     Key,
     check_top_level,
     in_range,
+    one_of,
     parse_entry,
     parse_section,
     read_yaml_file,
@@ -54,9 +124,25 @@ WHAT = "world"
 # to it); in an install space the worlds are under share/thorvald_sim instead.
 PACKAGE_DIR = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 
+Rgba = Tuple[float, float, float, float]
+Point = Tuple[float, float]
+
+RGBA_TARMAC = (0.35, 0.35, 0.37, 1.0)
+RGBA_WOOD = (0.60, 0.45, 0.28, 1.0)
+RGBA_LEAF = (0.25, 0.55, 0.20, 1.0)
+RGBA_CONCRETE = (0.75, 0.74, 0.70, 1.0)
+
+PATCH_TOP = 0.001  # [m] above the ground plane: a patch's top
+TABLE_DEPTH = 0.2  # [m] of a table-top's trough, below table_height
+STRAWBERRY_RADIUS = 0.3  # of table_width: the foliage balls on a table or bed
+ARCH_SEGMENTS = 16  # straight tubes of a hoop's arch (even: the ridge is a joint)
+FLAT_BLEND = 1.0  # [m] over which a height field rises from its flat disc to full height
+MAX_PLANTS = 100_000  # per rows entry: a typing mistake in plant_spacing must not eat the memory
+MAX_FIELD_POINTS = 1_000_000  # of a height field's grid
+
 
 # ---------------------------------------------------------------------------------------------
-# Value types (SI units: m, rad, m/s^2)
+# Value types (SI units: m, rad, kg, m/s^2)
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Surface:
@@ -113,6 +199,14 @@ class Slope:
         """[m] along the hill, ramps included."""
         return self.top_length + 2.0 * self.height / math.tan(self.angle)
 
+    def height_at(self, px: float, py: float) -> Optional[float]:
+        """[m] of the hill's surface over the ground point (px, py); None off its footprint."""
+        u, v = _to_local(px - self.x, py - self.y, self.yaw)
+        half = self.footprint_length / 2
+        if abs(u) > half or abs(v) > self.width / 2:
+            return None
+        return min(self.height, (half - abs(u)) * math.tan(self.angle))
+
 
 @dataclass(frozen=True)
 class Rail:
@@ -131,6 +225,272 @@ class Rail:
 
 
 @dataclass(frozen=True)
+class WorldObject:
+    """One body: a box, cylinder, sphere or mesh; static when its mass is 0.
+
+    Only the shape's own dimensions are set; the others are 0 (``file`` empty).
+    """
+
+    name: str
+    index: int
+    shape: str  # box, cylinder, sphere or mesh
+    x: float  # [m] of the centre (a mesh's origin) in the world
+    y: float  # [m]
+    z: float  # [m] in the world (the file's z is above the ground; this is resolved)
+    roll: float  # [rad], pybullet's Euler angles: roll about x, then pitch about y, then yaw about z
+    pitch: float  # [rad]
+    yaw: float  # [rad]
+    size_x: float  # [m] box
+    size_y: float  # [m]
+    size_z: float  # [m]
+    radius: float  # [m] cylinder, sphere
+    length: float  # [m] cylinder, along its own z
+    file: str  # mesh: the absolute path of an OBJ or STL file
+    scale: float  # [-] mesh
+    mass: float  # [kg], 0 static
+    rgba: Rgba
+    surface: Surface
+
+    @property
+    def half_height(self) -> float:
+        """[m] from the centre to the bottom, upright (a mesh's origin: 0)."""
+        return {"box": self.size_z / 2, "cylinder": self.length / 2, "sphere": self.radius}.get(self.shape, 0.0)
+
+
+@dataclass(frozen=True)
+class Rows:
+    """``count`` parallel crop rows of plants, from a few numbers (:func:`plant_positions`)."""
+
+    name: str
+    index: int
+    x: float  # [m] start of the first row
+    y: float  # [m]
+    yaw: float  # [rad] direction the rows run in
+    count: int  # rows
+    spacing: float  # [m] between neighbouring rows, each to the left of the one before
+    length: float  # [m] of each row
+    plant: str  # cylinder or sphere
+    plant_spacing: float  # [m] along a row
+    plant_radius: float  # [m]
+    plant_height: float  # [m] of the plant's top above the ground
+    gap_probability: float  # [-] of each plant to be missing
+    jitter: float  # [m] largest move of a plant along and across its row
+    seed: int
+    rgba: Rgba
+    surface: Surface
+
+    @property
+    def plants_per_row(self) -> int:
+        """Places for plants along a row, from its start to its end (both included)."""
+        # a row of exactly k spacings ends with a plant, though floating point makes it 2.9999...
+        return math.floor(self.length / self.plant_spacing + 1e-9) + 1
+
+    def row_start(self, k: int) -> Point:
+        """[m] the start of row k (0 the first)."""
+        return _along(self.x, self.y, self.yaw, 0.0, k * self.spacing)
+
+
+def plant_positions(rows: Rows) -> Tuple[Tuple[Point, ...], ...]:
+    """The plants of each row, (x, y) [m] in the world, in order along the row; gaps left out.
+
+    Row k's plant i sits at ``i * plant_spacing`` along the row and ``k * spacing`` to the left of
+    the first row, moved by ``du``, ``dv`` drawn uniformly from [-jitter, jitter]. One generator,
+    seeded by ``seed``, gives three numbers a place, row after row and place after place: whether the
+    plant is missing, du, dv. They are drawn for missing plants too, so another gap probability takes
+    plants away or puts them back without moving the others.
+    """
+    rng = random.Random(rows.seed)
+    j = rows.jitter
+    lines = []
+    for k in range(rows.count):
+        line = []
+        for i in range(rows.plants_per_row):
+            missing = rng.random() < rows.gap_probability
+            du = rng.uniform(-j, j)
+            dv = rng.uniform(-j, j)
+            if not missing:
+                line.append(_along(rows.x, rows.y, rows.yaw, i * rows.plant_spacing + du, k * rows.spacing + dv))
+        lines.append(tuple(line))
+    return tuple(lines)
+
+
+@dataclass(frozen=True)
+class Polytunnel:
+    """A tunnel of hoops on legs, with table-tops (or ground beds) of strawberries inside.
+
+    Its own frame: u along the tunnel from its centre, v across it (to the left), z up from its floor.
+    """
+
+    name: str
+    index: int
+    x: float  # [m] centre of the floor
+    y: float  # [m]
+    z: float  # [m] of the floor in the world: the ground height at the centre
+    yaw: float  # [rad] direction the tunnel runs in
+    length: float  # [m]
+    width: float  # [m] between the leg rows (the centres of the legs)
+    height: float  # [m] of the ridge (the centre of its pole) above the floor
+    leg_height: float  # [m] where the straight legs end and the arch begins
+    hoop_spacing: float  # [m] asked for; the hoops are length / round(length / hoop_spacing) apart
+    tube: float  # [m] side of the square tubes
+    crop: str  # table_tops, ground_beds or none
+    tables: int  # rows of tables (or beds) across the tunnel
+    table_height: float  # [m] of a table-top's top
+    table_width: float  # [m]
+    leg_spacing: float  # [m] asked for between a table's leg pairs (shrunk to fit, as the hoops)
+    bed_height: float  # [m] of a ground bed
+    end_gap: float  # [m] from each end of the tunnel to the ends of the tables
+    plant_spacing: float  # [m] between strawberry plants along a table
+    surface: Surface
+
+    def to_world(self, u: float, v: float) -> Point:
+        """The world point [m] of the tunnel point (u, v)."""
+        return _along(self.x, self.y, self.yaw, u, v)
+
+    def hoop_stations(self) -> Tuple[float, ...]:
+        """u [m] of every hoop, from end to end."""
+        return _stations(-self.length / 2, self.length / 2, self.hoop_spacing)
+
+    def arch(self) -> Tuple[Point, ...]:
+        """(v, z) [m] of the arch's joints from the left leg's top to the right one's, ridge included."""
+        rise = self.height - self.leg_height
+        points = []
+        for i in range(ARCH_SEGMENTS + 1):
+            a = math.pi * i / ARCH_SEGMENTS
+            points.append((self.width / 2 * math.cos(a), self.leg_height + rise * math.sin(a)))
+        return tuple(points)
+
+    def roof_height(self, v: float) -> float:
+        """[m] of the hoops' centre line above the floor at v (|v| <= width / 2), the arch as an ellipse."""
+        s = min(1.0, abs(v) / (self.width / 2))
+        return self.leg_height + (self.height - self.leg_height) * math.sqrt(1.0 - s * s)
+
+    def table_offsets(self) -> Tuple[float, ...]:
+        """v [m] of each table's (or bed's) centre line."""
+        if self.crop == "none":
+            return ()
+        pitch = self.width / self.tables
+        return tuple(-self.width / 2 + pitch * (i + 0.5) for i in range(self.tables))
+
+    def table_span(self) -> Tuple[float, float]:
+        """u [m] of the tables' ends."""
+        return -self.length / 2 + self.end_gap, self.length / 2 - self.end_gap
+
+    def table_leg_stations(self) -> Tuple[float, ...]:
+        """u [m] of each pair of a table's legs (table-tops only)."""
+        if self.crop != "table_tops":
+            return ()
+        return _stations(*self.table_span(), self.leg_spacing)
+
+    def plant_stations(self) -> Tuple[float, ...]:
+        """u [m] of the strawberry plants along each table or bed, half a spacing in from its ends."""
+        if self.crop == "none":
+            return ()
+        start, end = self.table_span()
+        n = math.floor((end - start) / self.plant_spacing + 1e-9)
+        return tuple(start + self.plant_spacing * (i + 0.5) for i in range(n))
+
+    @property
+    def crop_top(self) -> float:
+        """[m] above the floor of a table's top or a bed's."""
+        return self.table_height if self.crop == "table_tops" else self.bed_height
+
+    @property
+    def plant_radius(self) -> float:
+        """[m] of a strawberry plant's foliage ball."""
+        return STRAWBERRY_RADIUS * self.table_width
+
+    @property
+    def plant_top(self) -> float:
+        """[m] above the floor of a strawberry plant's top: its centre is half a radius above the table."""
+        return self.crop_top + 1.5 * self.plant_radius
+
+
+@dataclass(frozen=True)
+class Wall:
+    """A box standing on the ground."""
+
+    name: str
+    index: int
+    x: float  # [m] centre
+    y: float  # [m]
+    z: float  # [m] of its foot in the world: the lowest ground along it
+    yaw: float  # [rad] direction the wall runs in
+    length: float  # [m]
+    height: float  # [m]
+    thickness: float  # [m]
+    rgba: Rgba
+    surface: Surface
+
+
+@dataclass(frozen=True)
+class HeightField:
+    """Uneven ground on a regular grid: an image's grey levels, bumps and ruts (:meth:`heights`)."""
+
+    x: float  # [m] centre
+    y: float  # [m]
+    size_x: float  # [m]
+    size_y: float  # [m]
+    resolution: float  # [m] asked for between grid points (0 with an image: its pixels are the grid)
+    image: str  # absolute path, or ""
+    min_height: float  # [m] of black
+    max_height: float  # [m] of white
+    amplitude: float  # [m] of the bumps, up and down
+    feature_length: float  # [m] between the bumps' random heights
+    seed: int
+    rut_depth: float  # [m]
+    rut_width: float  # [m]
+    rut_spacing: float  # [m] between neighbouring ruts' centre lines
+    flat_radius: float  # [m] around the world's origin where the field is 0
+
+    def grid_shape(self) -> Tuple[int, int]:
+        """(nx, ny): grid points along x and along y."""
+        if self.image:
+            ny, nx = self._levels.shape
+            return nx, ny
+        return _points(self.size_x, self.resolution), _points(self.size_y, self.resolution)
+
+    def grid_step(self) -> Tuple[float, float]:
+        """[m] between grid points along x and along y (the resolution, shrunk to fit the size)."""
+        nx, ny = self.grid_shape()
+        return self.size_x / (nx - 1), self.size_y / (ny - 1)
+
+    def heights(self):
+        """The grid's heights [m] (a read-only numpy array ny x nx; row 0 is the -y edge, column 0 the -x edge)."""
+        return self._heights
+
+    # Made once per field (a frozen dataclass keeps a cached_property in its __dict__, outside its
+    # fields): the image is read again by the next load of the world, so an edited image counts.
+    @functools.cached_property
+    def _levels(self):
+        return _image_levels(self.image)
+
+    @functools.cached_property
+    def _heights(self):
+        return _field_heights(self)
+
+    def height_at(self, px: float, py: float) -> Optional[float]:
+        """[m] of the surface at (px, py), as bullet draws it between the grid points; None off the field.
+
+        bullet's height field splits each cell into two triangles along the diagonal from its
+        (+x, -y) corner to its (-x, +y) corner, and is flat on each.
+        """
+        nx, ny = self.grid_shape()
+        dx, dy = self.grid_step()
+        u = (px - (self.x - self.size_x / 2)) / dx
+        v = (py - (self.y - self.size_y / 2)) / dy
+        if not (-1e-9 <= u <= nx - 1 + 1e-9 and -1e-9 <= v <= ny - 1 + 1e-9):
+            return None
+        i, j = min(max(math.floor(u), 0), nx - 2), min(max(math.floor(v), 0), ny - 2)
+        fu, fv = u - i, v - j
+        h = self.heights()
+        h00, h10, h01, h11 = h[j, i], h[j, i + 1], h[j + 1, i], h[j + 1, i + 1]
+        if fu + fv <= 1.0:
+            return float(h00 + fu * (h10 - h00) + fv * (h01 - h00))
+        return float(h11 + (1.0 - fu) * (h01 - h11) + (1.0 - fv) * (h10 - h11))
+
+
+@dataclass(frozen=True)
 class WorldConfig:
     """A validated world file."""
 
@@ -141,11 +501,125 @@ class WorldConfig:
     slopes: Tuple[Slope, ...]
     rails: Tuple[Rail, ...]
     description: str = ""
+    objects: Tuple[WorldObject, ...] = ()
+    rows: Tuple[Rows, ...] = ()
+    polytunnels: Tuple[Polytunnel, ...] = ()
+    walls: Tuple[Wall, ...] = ()
+    height_field: Optional[HeightField] = None
+    ground_rgba: Rgba = RGBA_TARMAC
+
+    def ground_height(self, px: float, py: float) -> float:
+        """[m] of the ground's surface at (px, py): the height field (0 off it, or without one), the
+        hills and the patches' tops, whichever is highest (not rails, objects, plants or tunnels)."""
+        return _ground_height(self.height_field, self.slopes, self.patches, px, py)
+
+
+def _ground_height(
+    height_field: Optional[HeightField], slopes: Sequence[Slope], patches: Sequence[Patch], px: float, py: float
+) -> float:
+    z = 0.0
+    if height_field is not None:
+        z = height_field.height_at(px, py) or 0.0
+    for slope in slopes:
+        z = max(z, slope.height_at(px, py) or 0.0)
+    if any(patch.contains(px, py) for patch in patches):
+        z = max(z, PATCH_TOP)
+    return z
 
 
 def _to_local(dx: float, dy: float, yaw: float) -> Tuple[float, float]:
     c, s = math.cos(yaw), math.sin(yaw)
     return c * dx + s * dy, -s * dx + c * dy
+
+
+def _along(x: float, y: float, yaw: float, u: float, v: float) -> Point:
+    """The world point of (u, v) in a frame at (x, y) turned by yaw."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    return x + c * u - s * v, y + s * u + c * v
+
+
+def _stations(start: float, end: float, spacing: float) -> Tuple[float, ...]:
+    """Evenly spread points from start to end (both included), as near ``spacing`` apart as fits."""
+    n = max(1, round((end - start) / spacing))
+    return tuple(start + (end - start) * k / n for k in range(n + 1))
+
+
+def _points(size: float, resolution: float) -> int:
+    return max(2, round(size / resolution) + 1)
+
+
+# ---------------------------------------------------------------------------------------------
+# Height fields (numpy and PIL are imported when a field is made: importing this module stays cheap)
+# ---------------------------------------------------------------------------------------------
+def _image_levels(path: str):
+    """The image's grey levels in [0, 1] (numpy, rows from the -y edge); ValueError if it cannot be read."""
+    import numpy as np  # noqa: PLC0415
+    from PIL import Image, UnidentifiedImageError  # noqa: PLC0415
+
+    try:
+        with Image.open(path) as image:
+            image.load()
+            if image.mode in ("I;16", "I;16L", "I;16B", "I"):
+                levels = np.asarray(image, dtype=np.float64) / 65535.0
+            else:
+                levels = np.asarray(image.convert("L"), dtype=np.float64) / 255.0
+    except (OSError, UnidentifiedImageError) as e:
+        raise ValueError(f"cannot read the image: {e}") from None
+    if levels.ndim != 2 or min(levels.shape) < 2:
+        raise ValueError(f"must be an image of at least 2 x 2 pixels, not {levels.shape[::-1]}")
+    levels = np.clip(np.flipud(levels), 0.0, 1.0)  # the image's first row is the +y edge
+    levels.setflags(write=False)
+    return levels
+
+
+def _field_heights(hf: HeightField):
+    import numpy as np  # noqa: PLC0415
+
+    nx, ny = hf.grid_shape()
+    xs = np.linspace(-hf.size_x / 2, hf.size_x / 2, nx)  # from the field's centre
+    ys = np.linspace(-hf.size_y / 2, hf.size_y / 2, ny)
+    gx, gy = np.meshgrid(xs, ys)
+    h = np.zeros((ny, nx))
+    if hf.image:
+        h += hf.min_height + (hf.max_height - hf.min_height) * hf._levels
+    if hf.amplitude > 0:
+        h += hf.amplitude * _value_noise(gx / hf.feature_length, gy / hf.feature_length, hf.seed)
+    if hf.rut_depth > 0:
+        # distance from the nearest rut's centre line; ruts at (k + 1/2) rut_spacing across the field
+        d = np.abs((gy / hf.rut_spacing) % 1.0 - 0.5) * hf.rut_spacing
+        h -= np.where(d < hf.rut_width / 2, hf.rut_depth * 0.5 * (1 + np.cos(2 * np.pi * d / hf.rut_width)), 0.0)
+    if hf.flat_radius > 0:
+        # every grid point within a cell's diagonal beyond the radius is 0 too, so that each triangle
+        # over the disc is flat at 0, not just its points
+        r = np.hypot(gx + hf.x, gy + hf.y) - math.hypot(*hf.grid_step())
+        h *= _smoothstep((r - hf.flat_radius) / FLAT_BLEND)
+    h.setflags(write=False)
+    return h
+
+
+def _value_noise(u, v, seed: int):
+    """Smooth noise in [-1, 1] at lattice coordinates (u, v) (numpy arrays): random values at the
+    integer points, from one generator seeded by seed in row order over the lattice around (u, v),
+    blended with the smoothstep (continuous slopes, flat at the lattice points)."""
+    import numpy as np  # noqa: PLC0415
+
+    i0, j0 = int(np.floor(u.min())), int(np.floor(v.min()))
+    ni, nj = int(np.floor(u.max())) - i0 + 2, int(np.floor(v.max())) - j0 + 2
+    rng = random.Random(seed)
+    lattice = np.array([[rng.uniform(-1.0, 1.0) for _ in range(ni)] for _ in range(nj)])
+    iu, jv = np.floor(u).astype(int) - i0, np.floor(v).astype(int) - j0
+    iu, jv = np.minimum(iu, ni - 2), np.minimum(jv, nj - 2)
+    su, sv = _smoothstep(u - i0 - iu), _smoothstep(v - j0 - jv)
+    a = lattice[jv, iu] + su * (lattice[jv, iu + 1] - lattice[jv, iu])
+    b = lattice[jv + 1, iu] + su * (lattice[jv + 1, iu + 1] - lattice[jv + 1, iu])
+    return a + sv * (b - a)
+
+
+def _smoothstep(t):
+    import numpy as np  # noqa: PLC0415
+
+    t = np.clip(t, 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -154,12 +628,24 @@ def _to_local(dx: float, dy: float, yaw: float) -> Tuple[float, float]:
 GRAVITY_KEY = Key("gravity", float, 9.81, **POSITIVE)
 DESCRIPTION_KEY = Key("description", str, "")
 
-GROUND_KEYS = (
-    Key("lateral_friction", float, 0.9, **NON_NEGATIVE),
-    Key("rolling_friction", float, 0.0, **NON_NEGATIVE),
-    Key("spinning_friction", float, 0.0, **NON_NEGATIVE),
-    Key("restitution", float, 0.0, in_range(0.0, 1.0), "must be in [0, 1]"),
-)
+# rgba is a list, which the schema's keys do not take: it is checked apart (_take_colours) and stands
+# in the entry as an empty string, so that its key is known (for "did you mean") and given once.
+RGBA_KEY = Key("rgba", str, "")
+RGBA_RULE = "must be a list of 3 or 4 numbers in [0, 1] (red, green, blue, alpha)"
+
+
+def _frictions(lateral: float) -> Tuple[Key, ...]:
+    return (
+        Key("lateral_friction", float, lateral, **NON_NEGATIVE),
+        Key("rolling_friction", float, 0.0, **NON_NEGATIVE),
+        Key("spinning_friction", float, 0.0, **NON_NEGATIVE),
+    )
+
+
+UNIT_RANGE = dict(check=in_range(0.0, 1.0), rule="must be in [0, 1]")
+OPTIONAL_POSITIVE = dict(default=None, **POSITIVE)  # a key a cross-field rule requires or refuses
+
+GROUND_KEYS = (*_frictions(0.9), Key("restitution", float, 0.0, **UNIT_RANGE), RGBA_KEY)
 
 PATCH_KEYS = (
     Key("x", float),
@@ -182,9 +668,7 @@ SLOPE_KEYS = (
     Key("angle", float, check=lambda v: 0.0 < v <= MAX_SLOPE_ANGLE, rule=f"must be in (0, {MAX_SLOPE_ANGLE}] [rad]"),
     Key("height", float, **POSITIVE),
     Key("top_length", float, 0.0, **NON_NEGATIVE),
-    Key("lateral_friction", float, 0.9, **NON_NEGATIVE),
-    Key("rolling_friction", float, 0.0, **NON_NEGATIVE),
-    Key("spinning_friction", float, 0.0, **NON_NEGATIVE),
+    *_frictions(0.9),
 )
 
 RAIL_KEYS = (
@@ -195,13 +679,123 @@ RAIL_KEYS = (
     Key("gauge", float, 0.55, **POSITIVE),
     Key("height", float, 0.1, **POSITIVE),
     Key("radius", float, 0.0255, **POSITIVE),  # 51 mm pipes, the common greenhouse size
-    Key("lateral_friction", float, 0.8, **NON_NEGATIVE),
-    Key("rolling_friction", float, 0.0, **NON_NEGATIVE),
-    Key("spinning_friction", float, 0.0, **NON_NEGATIVE),
+    *_frictions(0.8),
 )
 
-SECTIONS = (("patches", "patch", PATCH_KEYS), ("slopes", "slope", SLOPE_KEYS), ("rails", "rail", RAIL_KEYS))
-TOP_LEVEL_KEYS = ("gravity", "ground", *(key for key, _, _ in SECTIONS), "description")
+SHAPES = ("box", "cylinder", "sphere", "mesh")
+# the keys of each shape's dimensions: required for it, refused for the others
+SHAPE_KEYS = {
+    "box": ("size_x", "size_y", "size_z"),
+    "cylinder": ("radius", "length"),
+    "sphere": ("radius",),
+    "mesh": ("file", "scale"),
+}
+MESH_EXTENSIONS = (".obj", ".stl")
+
+OBJECT_KEYS = (
+    Key("shape", str, check=one_of(*SHAPES), rule="must be one of " + ", ".join(SHAPES)),
+    Key("x", float),
+    Key("y", float),
+    Key("z", float, None),
+    Key("roll", float, 0.0),
+    Key("pitch", float, 0.0),
+    Key("yaw", float, 0.0),
+    Key("size_x", float, **OPTIONAL_POSITIVE),
+    Key("size_y", float, **OPTIONAL_POSITIVE),
+    Key("size_z", float, **OPTIONAL_POSITIVE),
+    Key("radius", float, **OPTIONAL_POSITIVE),
+    Key("length", float, **OPTIONAL_POSITIVE),
+    Key("file", str, None, check=bool, rule="must not be empty"),
+    Key("scale", float, **OPTIONAL_POSITIVE),
+    Key("mass", float, 0.0, **NON_NEGATIVE),
+    RGBA_KEY,
+    *_frictions(0.8),
+    Key("restitution", float, 0.0, **UNIT_RANGE),
+)
+
+PLANTS = ("cylinder", "sphere")
+
+ROWS_KEYS = (
+    Key("x", float),
+    Key("y", float),
+    Key("yaw", float, 0.0),
+    Key("count", int, 1, **POSITIVE),
+    Key("spacing", float, 0.75, **POSITIVE),
+    Key("length", float, **POSITIVE),
+    Key("plant", str, "cylinder", one_of(*PLANTS), "must be one of " + ", ".join(PLANTS)),
+    Key("plant_spacing", float, 0.3, **POSITIVE),
+    Key("plant_radius", float, 0.1, **POSITIVE),
+    Key("plant_height", float, 0.4, **POSITIVE),
+    Key("gap_probability", float, 0.0, aliases=("gaps",), **UNIT_RANGE),
+    Key("jitter", float, 0.0, **NON_NEGATIVE),
+    Key("seed", int, 0),
+    RGBA_KEY,
+    *_frictions(0.5),
+)
+
+CROPS = ("table_tops", "ground_beds", "none")
+
+POLYTUNNEL_KEYS = (
+    Key("x", float),
+    Key("y", float),
+    Key("yaw", float, 0.0),
+    Key("length", float, **POSITIVE),
+    Key("width", float, 8.0, **POSITIVE),
+    Key("height", float, 4.0, **POSITIVE),
+    Key("leg_height", float, 2.0, **NON_NEGATIVE),
+    Key("hoop_spacing", float, 2.0, **POSITIVE),
+    Key("tube", float, 0.05, **POSITIVE),
+    Key("crop", str, "table_tops", one_of(*CROPS), "must be one of " + ", ".join(CROPS)),
+    Key("tables", int, 4, **POSITIVE),
+    Key("table_height", float, 1.1, check=lambda v: v > TABLE_DEPTH, rule=f"must be > {TABLE_DEPTH} (the trough)"),
+    Key("table_width", float, 0.4, **POSITIVE),
+    Key("leg_spacing", float, 1.8, **POSITIVE),
+    Key("bed_height", float, 0.2, **POSITIVE),
+    Key("end_gap", float, 1.5, **NON_NEGATIVE),
+    Key("plant_spacing", float, 0.25, **POSITIVE),
+    *_frictions(0.5),
+)
+
+WALL_KEYS = (
+    Key("x", float),
+    Key("y", float),
+    Key("yaw", float, 0.0),
+    Key("length", float, **POSITIVE),
+    Key("height", float, 2.0, **POSITIVE),
+    Key("thickness", float, 0.2, **POSITIVE),
+    RGBA_KEY,
+    *_frictions(0.8),
+)
+
+HEIGHT_FIELD_KEYS = (
+    Key("x", float, 0.0),
+    Key("y", float, 0.0),
+    Key("size_x", float, **POSITIVE),
+    Key("size_y", float, **POSITIVE),
+    Key("resolution", float, **OPTIONAL_POSITIVE),
+    Key("image", str, None, check=bool, rule="must not be empty"),
+    Key("min_height", float, None),
+    Key("max_height", float, None),
+    Key("amplitude", float, 0.0, **NON_NEGATIVE),
+    Key("feature_length", float, 1.0, **POSITIVE),
+    Key("seed", int, 0),
+    Key("rut_depth", float, 0.0, **NON_NEGATIVE),
+    Key("rut_width", float, 0.3, **POSITIVE),
+    Key("rut_spacing", float, 1.5, **POSITIVE),
+    Key("flat_radius", float, 2.0, **NON_NEGATIVE),
+)
+
+# (top-level key, entry prefix, keys); built in this order, the scene too
+SECTIONS = (
+    ("patches", "patch", PATCH_KEYS),
+    ("slopes", "slope", SLOPE_KEYS),
+    ("rails", "rail", RAIL_KEYS),
+    ("objects", "object", OBJECT_KEYS),
+    ("rows", "row", ROWS_KEYS),
+    ("polytunnels", "polytunnel", POLYTUNNEL_KEYS),
+    ("walls", "wall", WALL_KEYS),
+)
+TOP_LEVEL_KEYS = ("gravity", "ground", "height_field", *(key for key, _, _ in SECTIONS), "description")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -211,13 +805,18 @@ def load_world(path: str) -> WorldConfig:
     """Loads and validates a world file; raises ConfigError naming every problem.
 
     A file that cannot be read at all (missing, a directory, not text, not YAML) raises a
-    ConfigError with one problem at the top level, which formats as one line.
+    ConfigError with one problem at the top level, which formats as one line. Relative paths in
+    the file (meshes, images) are from the file's folder.
     """
-    return parse_world(read_yaml_file(path, WHAT), path)
+    return parse_world(read_yaml_file(path, WHAT), path, os.path.dirname(os.path.abspath(path)))
 
 
-def parse_world(data: Any, source: str = "<world>") -> WorldConfig:
-    """Validates an already parsed world (a YAML document or a ROS parameter tree)."""
+def parse_world(data: Any, source: str = "<world>", base_dir: Optional[str] = None) -> WorldConfig:
+    """Validates an already parsed world (a YAML document or a ROS parameter tree).
+
+    base_dir: the folder relative paths (meshes, images) are taken from; default the current one.
+    """
+    base_dir = os.path.abspath(base_dir or os.getcwd())
     problems: List[Problem] = []
     try:
         data = check_top_level(data, TOP_LEVEL_KEYS, problems)
@@ -231,25 +830,61 @@ def parse_world(data: Any, source: str = "<world>") -> WorldConfig:
 
     # A missing ground, or an empty ``ground:`` (YAML null), means every default, as for sections.
     raw_ground = data.get("ground")
-    ground_values = parse_entry({} if raw_ground is None else raw_ground, "ground", GROUND_KEYS, problems)
-    ground = Surface(**(ground_values or {k.name: k.default for k in GROUND_KEYS}))
+    raw_ground, ground_colour = _take_colour({} if raw_ground is None else raw_ground, "ground", RGBA_TARMAC, problems)
+    ground_values = parse_entry(raw_ground, "ground", GROUND_KEYS, problems)
+    if ground_values is None:
+        ground_values = {k.name: k.default for k in GROUND_KEYS}
+    ground = _surface(ground_values)
 
-    built = {}
+    height_field = None
+    if data.get("height_field") is not None:
+        height_field = _height_field(data["height_field"], base_dir, problems)
+
+    entries: Dict[str, List[Tuple[str, int, dict, Mapping]]] = {}
     for key, prefix, keys in SECTIONS:
-        entries = parse_section(data.get(key), key, prefix, keys, problems)
-        built[key] = tuple(_BUILDERS[key](name, index, values) for name, index, values in entries)
+        raw, colours = data.get(key), {}
+        if RGBA_KEY in keys:
+            raw, colours = _take_colours(raw, key, problems)
+        parsed = parse_section(raw, key, prefix, keys, problems)
+        entries[key] = [(name, index, values, _raw_entry(data.get(key), name)) for name, index, values in parsed]
+        for name, _, values, _ in entries[key]:
+            if RGBA_KEY in keys:
+                values["rgba"] = colours.get(name)
 
-    problems.extend(_rail_problems(built["rails"], problems))
+    patches = tuple(_patch(name, index, v) for name, index, v, _ in entries["patches"])
+    slopes = tuple(_slope(name, index, v) for name, index, v, _ in entries["slopes"])
+    rails = tuple(_rail(name, index, v) for name, index, v, _ in entries["rails"])
+    problems.extend(_rail_problems(rails, problems))
+
+    def ground_at(px: float, py: float) -> float:
+        return _ground_height(height_field, slopes, patches, px, py)
+
+    objects = tuple(
+        _object(name, index, v, raw, base_dir=base_dir, ground_at=ground_at, problems=problems)
+        for name, index, v, raw in entries["objects"]
+    )
+    rows = tuple(_rows(name, index, v, problems) for name, index, v, _ in entries["rows"])
+    polytunnels = tuple(
+        _polytunnel(name, index, v, ground_at, problems) for name, index, v, _ in entries["polytunnels"]
+    )
+    walls = tuple(_wall(name, index, v, ground_at) for name, index, v, _ in entries["walls"])
+
     if problems:
         raise ConfigError(source, problems, WHAT)
     return WorldConfig(
         source=source,
         gravity=gravity,
         ground=ground,
-        patches=built["patches"],
-        slopes=built["slopes"],
-        rails=built["rails"],
+        patches=patches,
+        slopes=slopes,
+        rails=rails,
         description=description,
+        objects=objects,
+        rows=rows,
+        polytunnels=polytunnels,
+        walls=walls,
+        height_field=height_field,
+        ground_rgba=ground_colour,
     )
 
 
@@ -263,8 +898,51 @@ def _scalar(data: Mapping, key: Key, problems: List[Problem]) -> Any:
     return values[key.name] if values else key.default
 
 
+def _raw_entry(section: Any, name: str) -> Mapping:
+    entry = section.get(name) if isinstance(section, Mapping) else None
+    return entry if isinstance(entry, Mapping) else {}
+
+
+def _colour(value: Any) -> Optional[Rgba]:
+    """The colour a list of 3 or 4 numbers in [0, 1] gives (alpha 1 if left out); None if it is not one."""
+    if not isinstance(value, (list, tuple)) or len(value) not in (3, 4):
+        return None
+    numbers = []
+    for v in value:
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v <= 1.0:
+            return None
+        numbers.append(float(v))
+    return (*numbers, 1.0) if len(numbers) == 3 else tuple(numbers)
+
+
+def _take_colour(entry: Any, path: str, default: Rgba, problems: List[Problem]) -> Tuple[Any, Rgba]:
+    """The entry with its rgba, checked here, replaced by "" for parse_entry, and the colour."""
+    if not isinstance(entry, Mapping) or "rgba" not in entry:
+        return entry, default
+    colour = _colour(entry["rgba"])
+    if colour is None:
+        problems.append(Problem(f"{path}.rgba", entry["rgba"], RGBA_RULE))
+    return {**entry, "rgba": ""}, colour or default
+
+
+def _take_colours(section: Any, key: str, problems: List[Problem]) -> Tuple[Any, Dict[str, Optional[Rgba]]]:
+    """The section with each entry's rgba taken out (as :func:`_take_colour`), and the colours by entry."""
+    if not isinstance(section, Mapping):
+        return section, {}
+    clean, colours = {}, {}
+    for name, entry in section.items():
+        clean[name], colour = _take_colour(entry, f"{key}.{name}", None, problems)
+        colours[str(name)] = colour
+    return clean, colours
+
+
 def _surface(values: Mapping) -> Surface:
-    return Surface(values["lateral_friction"], values["rolling_friction"], values["spinning_friction"])
+    return Surface(
+        values["lateral_friction"],
+        values["rolling_friction"],
+        values["spinning_friction"],
+        values.get("restitution", 0.0),
+    )
 
 
 def _patch(name: str, index: int, v: Mapping) -> Patch:
@@ -281,16 +959,13 @@ def _rail(name: str, index: int, v: Mapping) -> Rail:
     return Rail(name, index, v["x"], v["y"], v["yaw"], v["length"], v["gauge"], v["height"], v["radius"], _surface(v))
 
 
-_BUILDERS = {"patches": _patch, "slopes": _slope, "rails": _rail}
-
-
 def _rail_problems(rails: Tuple[Rail, ...], found: List[Problem]) -> List[Problem]:
     problems = []
     for rail in rails:
         path = f"rails.{rail.name}"
         # A key that already broke its own rule was replaced by its default; comparing that default
         # would report a value the file does not hold.
-        if any(p.path in (f"{path}.radius", f"{path}.height", f"{path}.gauge") for p in found):
+        if _broken(found, path, "radius", "height", "gauge"):
             continue
         if rail.radius >= rail.height:
             problems.append(
@@ -309,6 +984,153 @@ def _rail_problems(rails: Tuple[Rail, ...], found: List[Problem]) -> List[Proble
                 )
             )
     return problems
+
+
+def _broken(problems: Sequence[Problem], path: str, *keys: str) -> bool:
+    """Whether one of the entry's keys has a problem already (its value was replaced by the default)."""
+    paths = {f"{path}.{k}" for k in keys}
+    return any(p.path in paths for p in problems)
+
+
+def _file(value: str, base_dir: str, path: str, problems: List[Problem], extensions: Sequence[str] = ()) -> str:
+    """The absolute path of a file the world names (relative to base_dir); a problem if it is not there."""
+    full = os.path.normpath(os.path.join(base_dir, os.path.expanduser(value)))
+    if extensions and not full.lower().endswith(tuple(extensions)):
+        names = " or ".join(e[1:].upper() for e in extensions)
+        problems.append(Problem(path, value, f"must be an {names} file ({', '.join(extensions)})"))
+    elif not os.path.isfile(full):
+        problems.append(Problem(path, value, f"no such file: {full} (a relative path is from the world file's folder)"))
+    return full
+
+
+def _object(name, index, v, raw, *, base_dir, ground_at, problems) -> WorldObject:
+    path = f"objects.{name}"
+    shape = v["shape"]
+    others = {k for keys in SHAPE_KEYS.values() for k in keys} - set(SHAPE_KEYS[shape])
+    for k in sorted(others & set(raw)):
+        wanted = ", ".join(SHAPE_KEYS[shape])
+        problems.append(Problem(f"{path}.{k}", raw[k], f"is not a key of a {shape} (it takes {wanted})"))
+    for k in SHAPE_KEYS[shape]:
+        if v[k] is None and k != "scale" and not _broken(problems, path, k):
+            problems.append(Problem(f"{path}.{k}", MISSING, f"is required for a {shape}"))
+    dims = {k: v[k] or 0.0 for k in ("size_x", "size_y", "size_z", "radius", "length")}
+    file = ""
+    if shape == "mesh" and v["file"]:
+        file = _file(v["file"], base_dir, f"{path}.file", problems, MESH_EXTENSIONS)
+    colour = v["rgba"] or RGBA_WOOD
+    thing = WorldObject(
+        name, index, shape, v["x"], v["y"], 0.0, v["roll"], v["pitch"], v["yaw"], **dims, file=file,
+        scale=v["scale"] or 1.0, mass=v["mass"], rgba=colour, surface=_surface(v),
+    )  # fmt: skip
+    above = thing.half_height if v["z"] is None else v["z"]
+    return replace(thing, z=ground_at(v["x"], v["y"]) + above)
+
+
+def _rows(name, index, v, problems) -> Rows:
+    path = f"rows.{name}"
+    rows = Rows(
+        name, index, v["x"], v["y"], v["yaw"], v["count"], v["spacing"], v["length"], v["plant"], v["plant_spacing"],
+        v["plant_radius"], v["plant_height"], v["gap_probability"], v["jitter"], v["seed"], v["rgba"] or RGBA_LEAF,
+        _surface(v),
+    )  # fmt: skip
+    if rows.plant == "sphere" and rows.plant_height < rows.plant_radius and not _broken(problems, path, "plant_height"):
+        rule = f"must be >= plant_radius ({rows.plant_radius} m) for a sphere: its centre would be below the ground"
+        problems.append(Problem(f"{path}.plant_height", rows.plant_height, rule))
+    if not _broken(problems, path, "count", "length", "plant_spacing"):
+        plants = rows.count * rows.plants_per_row
+        if plants > MAX_PLANTS:
+            rule = f"makes {plants} plants with count {rows.count} and length {rows.length} m; at most {MAX_PLANTS}"
+            problems.append(Problem(f"{path}.plant_spacing", rows.plant_spacing, rule))
+    return rows
+
+
+def _polytunnel(name, index, v, ground_at, problems) -> Polytunnel:
+    path = f"polytunnels.{name}"
+    z = ground_at(v["x"], v["y"])
+    tunnel = Polytunnel(
+        name, index, v["x"], v["y"], z, v["yaw"], v["length"], v["width"], v["height"], v["leg_height"],
+        v["hoop_spacing"], v["tube"], v["crop"], v["tables"], v["table_height"], v["table_width"], v["leg_spacing"],
+        v["bed_height"], v["end_gap"], v["plant_spacing"], _surface(v),
+    )  # fmt: skip
+    t = tunnel
+    if not _broken(problems, path, "height", "leg_height") and t.height <= t.leg_height:
+        problems.append(Problem(f"{path}.height", t.height, f"must be > leg_height ({t.leg_height} m)"))
+        return tunnel
+    if not _broken(problems, path, "end_gap", "length") and 2 * t.end_gap >= t.length:
+        rule = f"must be < length / 2 ({t.length / 2} m): the tables would have no length"
+        problems.append(Problem(f"{path}.end_gap", t.end_gap, rule))
+    if t.crop == "none" or _broken(problems, path, "tables", "table_width", "width", "table_height", "crop"):
+        return tunnel
+    if t.tables * t.table_width >= t.width:
+        rule = f"times tables ({t.tables}) must be < width ({t.width} m): an aisle between the tables"
+        problems.append(Problem(f"{path}.table_width", t.table_width, rule))
+        return tunnel
+    outer = max(abs(o) for o in t.table_offsets()) + t.table_width / 2
+    roof = t.roof_height(outer) - t.tube / 2
+    if t.crop_top + 1.5 * t.plant_radius >= roof:
+        key = "table_height" if t.crop == "table_tops" else "bed_height"
+        rule = (
+            f"puts the plants ({1.5 * t.plant_radius:.3g} m above it) under the roof ({roof:.3g} m at the outer table)"
+        )
+        problems.append(Problem(f"{path}.{key}", t.crop_top, "is too high: " + rule))
+    return tunnel
+
+
+def _wall(name, index, v, ground_at) -> Wall:
+    # the foot follows the lowest ground along the wall's centre line (every 0.5 m)
+    n = max(1, math.ceil(v["length"] / 0.5))
+    foot = min(ground_at(*_along(v["x"], v["y"], v["yaw"], v["length"] * (k / n - 0.5), 0.0)) for k in range(n + 1))
+    return Wall(
+        name, index, v["x"], v["y"], foot, v["yaw"], v["length"], v["height"], v["thickness"],
+        v["rgba"] or RGBA_CONCRETE, _surface(v),
+    )  # fmt: skip
+
+
+def _height_field(raw: Any, base_dir: str, problems: List[Problem]) -> Optional[HeightField]:
+    v = parse_entry(raw, "height_field", HEIGHT_FIELD_KEYS, problems)
+    if v is None:
+        return None
+    path = "height_field"
+    image, levels = "", None
+    if v["image"]:
+        image = _file(v["image"], base_dir, f"{path}.image", problems)
+        if os.path.isfile(image):
+            try:
+                levels = _image_levels(image)
+            except ValueError as e:
+                problems.append(Problem(f"{path}.image", v["image"], str(e)))
+                image = ""
+        else:
+            image = ""
+        if v["resolution"] is not None:
+            rule = "must not be given with an image: its pixels are the grid"
+            problems.append(Problem(f"{path}.resolution", v["resolution"], rule))
+    elif "image" not in raw:
+        for k in ("min_height", "max_height"):
+            if v[k] is not None:
+                problems.append(Problem(f"{path}.{k}", v[k], "is used with an image only"))
+    low = 0.0 if v["min_height"] is None else v["min_height"]
+    high = 1.0 if v["max_height"] is None else v["max_height"]
+    if high <= low:
+        problems.append(Problem(f"{path}.max_height", high, f"must be > min_height ({low} m)"))
+    if v["rut_width"] > v["rut_spacing"] and not _broken(problems, path, "rut_width", "rut_spacing"):
+        problems.append(Problem(f"{path}.rut_width", v["rut_width"], f"must be <= rut_spacing ({v['rut_spacing']} m)"))
+    hf = HeightField(
+        v["x"], v["y"], v["size_x"], v["size_y"], 0.0 if image else (v["resolution"] or 0.2), image, low, high,
+        v["amplitude"], v["feature_length"], v["seed"], v["rut_depth"], v["rut_width"], v["rut_spacing"],
+        v["flat_radius"],
+    )  # fmt: skip
+    if "image" in raw and not image:
+        return None  # the problem is reported; there is no grid to make
+    if levels is not None:
+        hf.__dict__["_levels"] = levels  # the image as read to check it (the cached property's place)
+    nx, ny = hf.grid_shape()
+    if nx * ny > MAX_FIELD_POINTS:
+        rule = f"makes {nx} x {ny} grid points; at most {MAX_FIELD_POINTS}"
+        key = "image" if image else "resolution"
+        problems.append(Problem(f"{path}.{key}", raw.get(key, hf.resolution), rule))
+        return None
+    return hf
 
 
 # ---------------------------------------------------------------------------------------------
@@ -352,13 +1174,19 @@ def resolve_world(name_or_path: str) -> str:
 
 __all__ = [
     "ConfigError",
+    "HeightField",
     "Patch",
+    "Polytunnel",
     "Rail",
+    "Rows",
     "Slope",
     "Surface",
+    "Wall",
     "WorldConfig",
+    "WorldObject",
     "load_world",
     "parse_world",
+    "plant_positions",
     "resolve_world",
     "shipped_worlds",
     "worlds_dir",

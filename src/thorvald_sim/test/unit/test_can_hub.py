@@ -59,13 +59,13 @@ def test_participants_see_each_other(hub):
     try:
         a.send(can.Message(arbitration_id=0x123, data=[1, 2, 3], is_extended_id=False))
         for bus in (b, inside):  # the other port and the in-process participant
-            got = bus.recv(2.0)
+            got = bus.recv(5.0)
             assert got is not None and (got.arbitration_id, bytes(got.data)) == (0x123, b"\x01\x02\x03")
         inside.send(can.Message(arbitration_id=0x18FF0001, data=[9], is_extended_id=True))
         for bus in (a, b):
-            got = bus.recv(2.0)
+            got = bus.recv(5.0)
             while got is not None and got.arbitration_id != 0x18FF0001:
-                got = bus.recv(2.0)
+                got = bus.recv(5.0)
             assert got is not None and got.is_extended_id
         assert a.recv(0.2) is None  # nobody sees its own frames
     finally:

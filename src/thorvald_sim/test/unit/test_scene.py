@@ -2,6 +2,7 @@
 sliding on ice and on tarmac that the friction is the world's."""
 
 import math
+import time
 
 import pybullet as p
 import pytest
@@ -10,13 +11,6 @@ from thorvald_sim.scene import build_scene
 from thorvald_sim.world import load_world, parse_world, resolve_world, shipped_worlds
 
 TOP = 5.0  # [m]: rays start this high and end 1 m below the ground
-
-
-@pytest.fixture
-def client():
-    c = p.connect(p.DIRECT)
-    yield c
-    p.disconnect(c)
 
 
 def shipped(name):
@@ -44,26 +38,63 @@ def surface_of(client, body):
 # ---------------------------------------------------------------------------------------------
 # Every shipped world
 # ---------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("name", ["flat", "greenhouse", "slope", "tarmac_gravel"])
+def expected_bodies(world):
+    """The scene's body names in order, but the ``.partN`` of meshes split for their size."""
+    names = ["ground"]
+    names += [f"patches.{pa.name}" for pa in world.patches]
+    names += [f"slopes.{s.name}" for s in world.slopes]
+    names += [f"rails.{r.name}.{side}" for r in world.rails for side in ("left", "right")]
+    names += [f"objects.{o.name}" for o in world.objects]
+    names += [f"rows.{r.name}.{k}" for r in world.rows for k in range(r.count)]
+    for t in world.polytunnels:
+        names += [f"polytunnels.{t.name}.{part}" for part in ("legs_left", "legs_right", "roof")]
+        names += [f"polytunnels.{t.name}.{kind}{k}" for k in range(t.tables) for kind in ("table", "plants", "berries")]
+    names += [f"walls.{w.name}" for w in world.walls]
+    return names
+
+
+@pytest.mark.parametrize("name", shipped_worlds())
 def test_every_shipped_world_builds(client, name):
-    assert name in shipped_worlds()
     world = shipped(name)
     scene = build_scene(client, world)
     assert scene.world is world
-    expected = ["ground"]
-    expected += [f"patches.{pa.name}" for pa in world.patches]
-    expected += [f"slopes.{s.name}" for s in world.slopes]
-    expected += [f"rails.{r.name}.{side}" for r in world.rails for side in ("left", "right")]
-    assert list(scene.bodies) == expected
-    assert p.getNumBodies(physicsClientId=client) == len(expected)
-    assert len(set(scene.bodies.values())) == len(expected)
-    for body in scene.bodies.values():
-        assert surface_of(client, body)["mass"] == 0.0, "static"
+    expected = expected_bodies(world)
+    assert [n for n in scene.bodies if ".part" not in n] == expected
+    assert p.getNumBodies(physicsClientId=client) == len(scene.bodies)
+    assert len(set(scene.bodies.values())) == len(scene.bodies)
+    moving = {f"objects.{o.name}" for o in world.objects if o.mass > 0}
+    for body_name, body in scene.bodies.items():
+        if body_name not in moving:
+            assert surface_of(client, body)["mass"] == 0.0, f"{body_name} static"
     gravity = p.getPhysicsEngineParameters(physicsClientId=client)
     assert (gravity["gravityAccelerationX"], gravity["gravityAccelerationY"]) == (0.0, 0.0)
     assert gravity["gravityAccelerationZ"] == pytest.approx(-world.gravity)
-    # far from everything, the ground plane at z = 0
-    assert ray_down(client, 60.0, -70.0) == (scene.bodies["ground"], pytest.approx(0.0, abs=1e-9))
+    if world.height_field is None:
+        # far from everything, the ground plane at z = 0
+        assert ray_down(client, 60.0, -70.0) == (scene.bodies["ground"], pytest.approx(0.0, abs=1e-9))
+
+
+@pytest.mark.parametrize("name", shipped_worlds())
+def test_every_shipped_world_leaves_room_for_a_robot_at_the_origin(client, name):
+    # a robot of 1.5 x 1.4 m and 1 m tall heading +x, and 5 cm more all round: rays down from 1.2 m every
+    # 5 cm over 1.6 x 1.5 m reach the ground, at 0 (the polytunnel's aisle between tables is 1.6 m wide)
+    scene = build_scene(client, shipped(name))
+    starts = [(i * 0.05, j * 0.05, 1.2) for i in range(-16, 17) for j in range(-15, 16)]
+    hits = p.rayTestBatch(starts, [(x, y, -1.0) for x, y, _ in starts], physicsClientId=client)
+    assert {h[0] for h in hits} == {scene.bodies["ground"]}
+    assert max(abs(h[3][2]) for h in hits) < 1e-6  # a height field's heights are 32-bit floats
+
+
+@pytest.mark.parametrize("name", shipped_worlds())
+def test_every_shipped_world_loads_in_well_under_a_few_seconds(name):
+    # CPU time, so that other work on the machine does not count
+    start = time.process_time()
+    client = p.connect(p.DIRECT)
+    try:
+        build_scene(client, shipped(name))
+    finally:
+        p.disconnect(client)
+    assert time.process_time() - start < 1.5
 
 
 def test_gravity_is_the_worlds(client):
@@ -188,15 +219,30 @@ def test_every_body_has_its_surface(client):
                 "slope0": {"x": -5, "y": 0, "width": 1, "angle": 0.3, "height": 0.2, "lateral_friction": 0.6},
             },
             "rails": {"rail0": {"x": 0, "y": 5, "length": 3, "lateral_friction": 0.5, "spinning_friction": 0.04}},
+            "objects": {
+                "object0": {"shape": "sphere", "x": 9, "y": 9, "radius": 0.2, "mass": 1, "restitution": 0.5},
+            },
+            "rows": {"row0": {"x": -9, "y": -9, "length": 2, "count": 2, "lateral_friction": 0.45}},
+            "polytunnels": {"polytunnel0": {"x": 20, "y": 0, "length": 6, "lateral_friction": 0.55, "tables": 1}},
+            "walls": {"wall0": {"x": 0, "y": -9, "length": 2, "rolling_friction": 0.05}},
         }
     )
     scene = build_scene(client, world)
+    tunnel = "polytunnels.polytunnel0"
     expected = {
         "ground": (0.7, 0.01, 0.02, 0.3),
         "patches.patch0": (0.4, 0.03, 0.0, 0.0),
         "slopes.slope0": (0.6, 0.0, 0.0, 0.0),
         "rails.rail0.left": (0.5, 0.0, 0.04, 0.0),
         "rails.rail0.right": (0.5, 0.0, 0.04, 0.0),
+        "objects.object0": (0.8, 0.0, 0.0, 0.5),
+        "rows.row0.0": (0.45, 0.0, 0.0, 0.0),
+        "rows.row0.1": (0.45, 0.0, 0.0, 0.0),
+        **{
+            f"{tunnel}.{part}": (0.55, 0.0, 0.0, 0.0)
+            for part in ("legs_left", "legs_right", "roof", "table0", "plants0")
+        },
+        "walls.wall0": (0.8, 0.05, 0.0, 0.0),
     }
     for name, (lateral, rolling, spinning, restitution) in expected.items():
         got = surface_of(client, scene.bodies[name])
@@ -204,6 +250,19 @@ def test_every_body_has_its_surface(client):
         assert got["rolling"] == pytest.approx(rolling), name
         assert got["spinning"] == pytest.approx(spinning), name
         assert got["restitution"] == pytest.approx(restitution), name
+
+
+def test_a_height_field_has_the_grounds_surface_and_colour(client):
+    world = parse_world(
+        {
+            "ground": {"lateral_friction": 0.6, "spinning_friction": 0.01, "rgba": [0.5, 0.4, 0.3]},
+            "height_field": {"size_x": 4, "size_y": 4, "amplitude": 0.1},
+        }
+    )
+    scene = build_scene(client, world)
+    got = surface_of(client, scene.bodies["ground"])
+    assert (got["lateral"], got["spinning"]) == pytest.approx((0.6, 0.01))
+    assert p.getVisualShapeData(scene.bodies["ground"], physicsClientId=client)[0][7] == (0.5, 0.4, 0.3, 1.0)
 
 
 def test_shipped_surfaces(client):

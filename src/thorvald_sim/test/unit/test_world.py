@@ -13,12 +13,13 @@ from thorvald_sim.world import (
     Surface,
     load_world,
     parse_world,
+    plant_positions,
     resolve_world,
     shipped_worlds,
     worlds_dir,
 )
 
-SHIPPED = ["flat", "greenhouse", "slope", "tarmac_gravel"]
+SHIPPED = ["crop_rows", "flat", "greenhouse", "polytunnel", "slope", "tarmac_gravel", "vineyard"]
 
 
 def write(tmp_path, data, name="world.yaml"):
@@ -59,7 +60,9 @@ def test_flat_is_ground_only():
     world = shipped("flat")
     assert world.ground == Surface(0.9, 0.0, 0.0, 0.0)
     assert (world.patches, world.slopes, world.rails) == ((), (), ())
+    assert (world.objects, world.rows, world.polytunnels, world.walls, world.height_field) == ((), (), (), (), None)
     assert world.gravity == 9.81
+    assert world.ground_rgba == (0.35, 0.35, 0.37, 1.0)
 
 
 def test_tarmac_gravel_has_the_slip_tests_ice_patch():
@@ -142,6 +145,25 @@ def test_greenhouse_has_three_rail_pairs_side_by_side_starting_2_m_ahead():
     for r in world.rails:
         assert (r.gauge, r.height, r.radius, r.length, r.yaw) == (0.55, 0.1, 0.0255, 20.0, 0.0)
         assert r.x - r.length / 2 == 2.0
+        assert r.x == 12.0 and r.surface == Surface(0.8, 0.0, 0.0)
+
+
+def test_greenhouse_plant_rows_lie_beside_the_pipes_and_walls_around_it_all():
+    world = shipped("greenhouse")
+    (rows,) = world.rows
+    # a row half-way between neighbouring pairs and one beside each outer pair, 1.6 m apart
+    assert [rows.row_start(k)[1] for k in range(rows.count)] == pytest.approx([-0.8, 0.8, 2.4, 4.0])
+    pipes = [y + side * r.gauge / 2 for r in world.rails for y in [r.y] for side in (-1, 1)]
+    for line in plant_positions(rows):
+        for x, y in line:
+            assert 2.0 - rows.jitter <= x <= 22.0 + rows.jitter
+            # every plant (moved by up to 2 cm) clear of every pipe by 0.8 - 0.02 - 0.275 - 0.0255 - 0.15 m
+            assert min(abs(y - pipe) for pipe in pipes) - 0.0255 - rows.plant_radius >= 0.3295 - 1e-9
+    # the walls enclose the rows and the origin
+    xs = [w.x + side * w.length / 2 for w in world.walls if w.yaw == 0 for side in (-1, 1)]
+    assert min(xs) <= -4.0 and max(xs) >= 26.0
+    assert sorted(w.y for w in world.walls if w.yaw == 0) == [-2.4, 5.6]
+    assert sorted(w.x for w in world.walls if w.yaw != 0) == [-4.0, 26.0]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -153,7 +175,9 @@ def test_an_empty_world_is_flat_tarmac_on_earth():
         assert world.gravity == 9.81
         assert world.ground == Surface(0.9, 0.0, 0.0, 0.0)
         assert (world.patches, world.slopes, world.rails, world.description) == ((), (), (), "")
+        assert (world.objects, world.rows, world.polytunnels, world.walls, world.height_field) == ((), (), (), (), None)
         assert world.source == "empty"
+        assert world.ground_height(3.0, -4.0) == 0.0
 
 
 def test_defaults_fill_every_optional_key():
@@ -324,7 +348,10 @@ def test_resolve_a_path(tmp_path, monkeypatch):
 def test_an_unknown_name_lists_the_shipped_worlds():
     with pytest.raises(ConfigError) as e:
         resolve_world("flatt")
-    assert str(e.value) == "flatt: no such world: give a file or one of flat, greenhouse, slope, tarmac_gravel"
+    assert str(e.value) == (
+        "flatt: no such world: give a file or one of crop_rows, flat, greenhouse, polytunnel, slope, tarmac_gravel, "
+        "vineyard"
+    )
 
 
 def test_the_worlds_folder_is_found_with_and_without_ros(monkeypatch):
