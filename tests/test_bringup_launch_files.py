@@ -40,6 +40,24 @@ def test_sim_launch_options():
     assert config.params["/r7/teleop_node/enable_button"].value == 4  # the xbox controller file
 
 
+def test_sim_launch_with_sensors_fits_the_example_sensors_and_your_extras_win():
+    def description(*args):
+        config = load(os.path.join(BRINGUP, "sim.launch"), list(args))
+        return config.params["/thorvald_001/robot_description"].value
+
+    plain = description()
+    assert "<sensor" not in plain
+    fitted = description("with_sensors:=true")
+    for plugin in ("libgazebo_ros_laser.so", "libgazebo_ros_imu_sensor.so", "libhector_gazebo_ros_gps.so"):
+        assert plugin in fitted
+    assert "libgazebo_ros_openni_kinect.so" in fitted
+    assert '<link name="thorvald_001/lidar_front_link"' in fitted
+    # a model_extras of the user's replaces the example
+    mine = os.path.join(HERE, "..", "src", "thorvald_sim", "test", "data", "row_lidar.xacro")
+    theirs = description("with_sensors:=true", f"model_extras:={mine}")
+    assert "thorvald_001/row_lidar_link" in theirs and "lidar_front_link" not in theirs
+
+
 def test_multi_sim_launch_has_four_robots_each_placed_in_world():
     config = load(os.path.join(BRINGUP, "multi_sim.launch"))
     for k in range(1, 5):
