@@ -246,6 +246,18 @@ def parse_entry(
     return values if complete else None
 
 
+def parse_scalar(data: Mapping, key: Key, problems: List[Problem]) -> Any:
+    """A top-level key's value of data (a file's mapping), checked as an entry's key is; its default
+    when absent or invalid (the problem recorded at the key's own name)."""
+    if key.name not in data:
+        return key.default
+    found: List[Problem] = []
+    values = parse_entry({key.name: data[key.name]}, "", (key,), found)
+    # parse_entry names a key of the entry at "" as ".gravity"; a top-level key has no dot
+    problems.extend(Problem(p.path.lstrip("."), p.value, p.rule) for p in found)
+    return values[key.name] if values else key.default
+
+
 KIND_NAMES = {float: "a finite number", int: "an integer", bool: "true or false (or 1 or 0)", str: "a string"}
 
 

@@ -114,6 +114,7 @@ from thorvald_model.schema import (
     in_range,
     one_of,
     parse_entry,
+    parse_scalar,
     parse_section,
     read_yaml_file,
 )
@@ -825,8 +826,8 @@ def parse_world(data: Any, source: str = "<world>", base_dir: Optional[str] = No
 
     # The two scalar keys go through parse_entry as a one-key entry each, so they get the same
     # coercion and rules as every other key; their paths are the bare key names.
-    gravity = _scalar(data, GRAVITY_KEY, problems)
-    description = _scalar(data, DESCRIPTION_KEY, problems)
+    gravity = parse_scalar(data, GRAVITY_KEY, problems)
+    description = parse_scalar(data, DESCRIPTION_KEY, problems)
 
     # A missing ground, or an empty ``ground:`` (YAML null), means every default, as for sections.
     raw_ground = data.get("ground")
@@ -886,16 +887,6 @@ def parse_world(data: Any, source: str = "<world>", base_dir: Optional[str] = No
         height_field=height_field,
         ground_rgba=ground_colour,
     )
-
-
-def _scalar(data: Mapping, key: Key, problems: List[Problem]) -> Any:
-    if key.name not in data:
-        return key.default
-    found: List[Problem] = []
-    values = parse_entry({key.name: data[key.name]}, "", (key,), found)
-    # parse_entry names a key of the entry at "" as ".gravity"; a top-level key has no dot
-    problems.extend(Problem(p.path.lstrip("."), p.value, p.rule) for p in found)
-    return values[key.name] if values else key.default
 
 
 def _raw_entry(section: Any, name: str) -> Mapping:

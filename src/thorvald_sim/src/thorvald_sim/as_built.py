@@ -1,0 +1,238 @@
+"""How a built robot differs from its configuration file: the simulator's as-built file.
+
+A robot is built to its configuration only approximately: tyres of slightly different rolling
+radii (pressure, wear), steering modules homed a little off, encoders that count in whole counts.
+The simulator builds the robot as its as-built file says, while base_driver, as on a real robot,
+runs on the configuration file alone and never sees this one. The file has the robot file's own
+shape::
+
+    motor_drives:
+      drive0: {r_wheel: 0.2015, steering_offset: 0.004}   # true rolling radius [m]; homing error [rad]
+      drive2: {r_wheel: 0.1987}
+    encoders: true      # report joints in whole encoder counts (prp_enc_ppr, str_enc_ppr, gear ratios)
+    delay: 0.02         # [s] measurement delay
+    mass_offset: 30.0   # [kg] a load on the frame
+
+Every key is optional: a drive not named is built as configured. ``steering_offset`` is the angle
+the wheel really stands at when the controller reads 0 (positive: turned to the left, as the
+steering angle); a drive that does not steer has none. Validated as the robot file is: every
+problem with the file, its key path, the value and the rule, together in one ConfigError.
+
+A profile draws the imperfections from stated tolerances with a seed (``field:SEED``, see
+:data:`PROFILES`): a uniform draw within each tolerance, drive by drive in order, so the same seed
+gives the same robot.
+
+Pure: no pybullet, no rospy, no messages.
+"""
+
+import math
+import random
+from dataclasses import dataclass
+from typing import Any, Dict, List, Mapping, Optional, Tuple
+
+from thorvald_model.errors import MISSING, ConfigError, Problem
+from thorvald_model.schema import Key, check_top_level, non_negative, parse_entry, parse_scalar, read_yaml_file
+from thorvald_model.values import RobotConfig
+
+WHAT = "as-built file"
+MAX_RADIUS_CHANGE = 0.2  # of the configured r_wheel: beyond it the file describes another wheel
+MAX_STEERING_OFFSET = 0.2  # [rad], about 11 degrees: beyond it the module is broken, not mis-homed
+MAX_DELAY = 1.0  # [s]
+
+DRIVE_KEYS = (
+    Key("r_wheel", float, None, check=lambda v: v > 0, rule="must be > 0"),
+    Key(
+        "steering_offset",
+        float,
+        0.0,
+        check=lambda v: abs(v) <= MAX_STEERING_OFFSET,
+        rule=f"must be within +-{MAX_STEERING_OFFSET} rad",
+    ),
+)
+ENCODERS_KEY = Key("encoders", bool, False)
+DELAY_KEY = Key("delay", float, 0.0, check=lambda v: 0 <= v <= MAX_DELAY, rule=f"must be in [0, {MAX_DELAY}] s")
+MASS_OFFSET_KEY = Key("mass_offset", float, 0.0, check=non_negative, rule="must be >= 0 (a load)")
+TOP_KEYS = ("motor_drives", "encoders", "delay", "mass_offset")
+
+
+@dataclass(frozen=True)
+class Profile:
+    """Tolerances an as-built robot is drawn from."""
+
+    radius: float  # [-] of the configured r_wheel: drawn uniformly from +-radius
+    steering_offset: float  # [rad]: drawn uniformly from +-steering_offset (steered drives)
+    encoders: bool
+
+
+PROFILES: Dict[str, Profile] = {
+    # a field robot: tyre pressure and wear +-1 % of the rolling radius, steering homed within +-0.5 deg,
+    # the encoders counting as configured
+    "field": Profile(radius=0.01, steering_offset=math.radians(0.5), encoders=True),
+}
+
+
+@dataclass(frozen=True)
+class DriveAsBuilt:
+    name: str  # driveN, as in the configuration
+    r_wheel: float  # [m] the true rolling radius
+    steering_offset: float  # [rad] the wheel's true angle when the controller reads 0
+
+
+@dataclass(frozen=True)
+class AsBuilt:
+    source: str  # the file, or the profile and seed ("field:7"), or "" for the robot as configured
+    drives: Tuple[DriveAsBuilt, ...]  # one per configured drive, in order
+    encoders: bool
+    delay: float  # [s]
+    mass_offset: float  # [kg]
+    configured: Tuple[float, ...]  # [m] each drive's r_wheel in the configuration
+
+    def drive(self, name: str) -> DriveAsBuilt:
+        for d in self.drives:
+            if d.name == name:
+                return d
+        raise KeyError(name)
+
+    @property
+    def ideal(self) -> bool:
+        """Built exactly to the configuration."""
+        return not self.encoders and self.delay == 0 and self.mass_offset == 0 and not self.differences()
+
+    def differences(self) -> Dict[str, Dict[str, float]]:
+        """The drives that differ from the configuration: {driveN: {key: value}} (for reports)."""
+        found = {}
+        for d, radius in zip(self.drives, self.configured):
+            values = {}
+            if d.r_wheel != radius:
+                values["r_wheel"] = d.r_wheel
+            if d.steering_offset != 0:
+                values["steering_offset"] = d.steering_offset
+            if values:
+                found[d.name] = values
+        return found
+
+
+def as_configured(config: RobotConfig) -> AsBuilt:
+    """The robot built exactly to its configuration."""
+    drives = tuple(DriveAsBuilt(_name(i), d.r_wheel, 0.0) for i, d in enumerate(config.drives))
+    return AsBuilt("", drives, False, 0.0, 0.0, _radii(config))
+
+
+def parse_as_built(data: Any, config: RobotConfig, source: str = "<as-built>") -> AsBuilt:
+    """The as-built robot a parsed file describes, for the robot of config; ConfigError naming every
+    problem."""
+    problems: List[Problem] = []
+    try:
+        data = check_top_level(data, TOP_KEYS, problems)
+    except ConfigError as e:
+        raise ConfigError(source, e.problems, WHAT) from None
+    encoders = parse_scalar(data, ENCODERS_KEY, problems)
+    delay = parse_scalar(data, DELAY_KEY, problems)
+    mass_offset = parse_scalar(data, MASS_OFFSET_KEY, problems)
+    given = _drive_entries(data.get("motor_drives"), config, problems)
+    drives = []
+    for i, d in enumerate(config.drives):
+        name = _name(i)
+        values = given.get(name, {})
+        path = f"motor_drives.{name}"
+        radius = values.get("r_wheel")
+        if radius is None:
+            radius = d.r_wheel
+        elif abs(radius / d.r_wheel - 1.0) > MAX_RADIUS_CHANGE:
+            rule = f"must be within {MAX_RADIUS_CHANGE:.0%} of the configured r_wheel ({d.r_wheel} m)"
+            problems.append(Problem(f"{path}.r_wheel", radius, rule))
+            radius = d.r_wheel
+        offset = values.get("steering_offset", 0.0)
+        if offset != 0 and not d.steerable:
+            problems.append(Problem(f"{path}.steering_offset", offset, "must be 0: this drive does not steer"))
+            offset = 0.0
+        drives.append(DriveAsBuilt(name, radius, offset))
+    if problems:
+        raise ConfigError(source, problems, WHAT)
+    return AsBuilt(source, tuple(drives), encoders, delay, mass_offset, _radii(config))
+
+
+def load_as_built(path: str, config: RobotConfig) -> AsBuilt:
+    """The as-built robot of a file (see the module's notes)."""
+    return parse_as_built(read_yaml_file(path, WHAT), config, path)
+
+
+def draw_as_built(profile_and_seed: str, config: RobotConfig) -> AsBuilt:
+    """A robot drawn from a profile's tolerances with a seed: ``field:7``."""
+    name, _, seed_text = profile_and_seed.partition(":")
+    problem = None
+    if name not in PROFILES:
+        problem = Problem("", profile_and_seed, "the profile must be one of " + ", ".join(sorted(PROFILES)))
+    elif not seed_text.strip().lstrip("-").isdigit():
+        problem = Problem("", profile_and_seed, f"must be PROFILE:SEED with an integer seed, e.g. {name}:1")
+    if problem is not None:
+        raise ConfigError("<as-built profile>", [problem], WHAT)
+    profile = PROFILES[name]
+    rng = random.Random(int(seed_text))
+    drives = []
+    for i, d in enumerate(config.drives):
+        # two draws a drive, steered or not, so one drive's type does not move the others' draws
+        scale = 1.0 + rng.uniform(-profile.radius, profile.radius)
+        offset = rng.uniform(-profile.steering_offset, profile.steering_offset)
+        drives.append(DriveAsBuilt(_name(i), d.r_wheel * scale, offset if d.steerable else 0.0))
+    return AsBuilt(profile_and_seed, tuple(drives), profile.encoders, 0.0, 0.0, _radii(config))
+
+
+def as_built_for(spec: str, config: RobotConfig) -> AsBuilt:
+    """What ``-as_built`` / ``as_built:=`` names: "" (as configured), a profile and seed
+    (``field:7``) or a file."""
+    if not spec:
+        return as_configured(config)
+    if spec.partition(":")[0] in PROFILES:
+        return draw_as_built(spec, config)
+    return load_as_built(spec, config)
+
+
+def quantise(angle: float, counts_per_radian: float) -> float:
+    """An angle [rad] as an encoder counts it: whole counts (rounded toward zero, as a counter
+    that has not reached the next edge)."""
+    return math.trunc(angle * counts_per_radian) / counts_per_radian
+
+
+def _name(index: int) -> str:
+    return f"drive{index}"
+
+
+def _radii(config: RobotConfig) -> Tuple[float, ...]:
+    return tuple(d.r_wheel for d in config.drives)
+
+
+def _drive_entries(raw: Any, config: RobotConfig, problems: List[Problem]) -> Dict[str, Dict[str, Any]]:
+    """The drives the file names, checked: only drives of the configuration, each a mapping of
+    DRIVE_KEYS."""
+    if raw is None:
+        return {}
+    if not isinstance(raw, Mapping):
+        problems.append(Problem("motor_drives", raw, "must be a mapping of the configuration's drives (drive0, ...)"))
+        return {}
+    known = [_name(i) for i in range(len(config.drives))]
+    entries = {}
+    for name, entry in raw.items():
+        path = f"motor_drives.{name}"
+        if str(name) not in known:
+            rule = f"is not a drive of the robot (it has {', '.join(known)})"
+            problems.append(Problem(path, MISSING, rule))
+            continue
+        values: Optional[dict] = parse_entry(entry, path, DRIVE_KEYS, problems)
+        if values is not None:
+            entries[str(name)] = values
+    return entries
+
+
+__all__ = [
+    "PROFILES",
+    "AsBuilt",
+    "DriveAsBuilt",
+    "Profile",
+    "as_built_for",
+    "as_configured",
+    "draw_as_built",
+    "load_as_built",
+    "parse_as_built",
+    "quantise",
+]
