@@ -61,10 +61,9 @@ def parse_robot_config(data: Any, source: str = "<robot configuration>", ignore:
     """
     problems: List[Problem] = []
     kept: List[Kept] = []
-    try:
-        data = check_top_level(data, TOP_LEVEL_KEYS, problems, ignore, kept=kept, mistakable=SCHEMA_TOP_LEVEL_KEYS)
-    except ConfigError as e:
-        raise ConfigError(source, e.problems) from None
+    data = check_top_level(
+        data, TOP_LEVEL_KEYS, problems, ignore, kept=kept, mistakable=SCHEMA_TOP_LEVEL_KEYS, source=source
+    )
 
     calculator = data.get("base_calculator", STD_CALCULATOR)
     if not isinstance(calculator, str) or not _CALCULATOR_NAME.match(calculator):

@@ -124,17 +124,20 @@ def check_top_level(
     *,
     kept: Optional[List[Kept]] = None,
     mistakable: Optional[Sequence[str]] = None,
+    source: Optional[str] = None,
+    what: str = "robot configuration",
 ) -> Mapping:
     """The document as a mapping (empty for an empty file); a problem for each unknown top-level key.
 
     With a ``kept`` list, an unknown key unlike any of ``mistakable`` (default: every known key) is
     the user's own and goes there instead; one like a known key stays a problem ("did you mean").
-    Raises ConfigError at once when the document is not a mapping at all (there is nothing more to check).
+    Raises ConfigError of source (a file of kind what) at once when the document is not a mapping
+    at all (there is nothing more to check).
     """
     if data is None:
         return {}
     if not isinstance(data, Mapping):
-        raise ConfigError(None, [Problem("", short(data), "the file must hold a mapping of keys")])
+        raise ConfigError(source, [Problem("", short(data), "the file must hold a mapping of keys")], what)
     ignore = set(ignore)
     for key in data:
         if key not in known and key not in ignore:

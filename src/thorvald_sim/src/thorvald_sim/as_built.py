@@ -122,10 +122,7 @@ def parse_as_built(data: Any, config: RobotConfig, source: str = "<as-built>") -
     """The as-built robot a parsed file describes, for the robot of config; ConfigError naming every
     problem."""
     problems: List[Problem] = []
-    try:
-        data = check_top_level(data, TOP_KEYS, problems)
-    except ConfigError as e:
-        raise ConfigError(source, e.problems, WHAT) from None
+    data = check_top_level(data, TOP_KEYS, problems, source=source, what=WHAT)
     encoders = parse_scalar(data, ENCODERS_KEY, problems)
     delay = parse_scalar(data, DELAY_KEY, problems)
     mass_offset = parse_scalar(data, MASS_OFFSET_KEY, problems)

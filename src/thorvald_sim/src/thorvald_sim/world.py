@@ -819,10 +819,7 @@ def parse_world(data: Any, source: str = "<world>", base_dir: Optional[str] = No
     """
     base_dir = os.path.abspath(base_dir or os.getcwd())
     problems: List[Problem] = []
-    try:
-        data = check_top_level(data, TOP_LEVEL_KEYS, problems)
-    except ConfigError as e:
-        raise ConfigError(source, e.problems, WHAT) from None
+    data = check_top_level(data, TOP_LEVEL_KEYS, problems, source=source, what=WHAT)
 
     # The two scalar keys go through parse_entry as a one-key entry each, so they get the same
     # coercion and rules as every other key; their paths are the bare key names.
