@@ -9,9 +9,12 @@ IMU 100 Hz, RTK-GNSS 10 Hz, RGB-D camera 320 x 240 at 10 Hz, 16 x 440 3D lidar a
 
 1. Per sensor: raw is pybullet alone, in this process, casting the same rays (rayTestBatch, the
    same beams from the same mount) or rendering the same image (getCameraImage, tiny renderer) at
-   the sensor's rate, CPU per simulated second; node is the simulator's own figure for that sensor
-   (its /diagnostics: CPU spent measuring, converting and publishing, per simulated second) with
-   every sensor of one robot subscribed. Target: node within 1.3 times raw.
+   the sensor's rate between the physics steps of a simulated second (240 steps: a ray test right
+   after a step finds the collision structures as the simulator's does, not hot in the cache from
+   the last ray test), CPU of the rays or renders per simulated second; node is the simulator's own
+   figure for that sensor (its /diagnostics: CPU spent measuring, converting and publishing, per
+   simulated second) while it is the one sensor read (the IMU and GNSS: with all read). Target:
+   node within 1.3 times raw.
 2. N robots (4) with these sensors, the simulator as fast as it can: real-time factor and the
    simulator's CPU per simulated second with no sensor subscribed, with the planar lidar, IMU and
    GNSS of every robot subscribed, and with everything subscribed; and the same robots without
@@ -20,6 +23,7 @@ IMU 100 Hz, RTK-GNSS 10 Hz, RGB-D camera 320 x 240 at 10 Hz, 16 x 440 3D lidar a
 """
 
 import argparse
+import functools
 import os
 import signal
 import subprocess
@@ -39,7 +43,13 @@ SPACING = 6.0
 TARGET_RATIO = 1.3
 TARGET_RTF = 2.0
 TARGET_IDLE = 0.01
+PHYSICS_RATE = 240.0  # the simulator's default
 LIGHT = ("scan", "imu/data", "gps/fix")  # the planar lidar, the IMU and the GNSS
+SENSOR_TOPICS = {  # of the sensors with a raw reference: what reading one alone subscribes
+    "front_lidar": ("scan",),
+    "velodyne": ("velodyne_points",),
+    "rgbd": ("rgb/image_raw", "depth/image_raw", "depth/points"),
+}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -68,24 +78,30 @@ def raw_costs(seconds: float):
                 continue
             origin, quat = sensor.pose()  # the same mount, computed once: raw does nothing else
             readings = max(1, round(seconds * spec.rate))
+            steps = max(1, round(PHYSICS_RATE / spec.rate))  # physics steps between two readings
             if spec.kind in ("laser", "multilayer"):
                 m = np.asarray(p.getMatrixFromQuaternion(quat)).reshape(3, 3)
                 d = sensor.directions.reshape(-1, 3) @ m.T
                 starts = (np.asarray(origin) + d * spec.config.range_min).tolist()
                 ends = (np.asarray(origin) + d * spec.config.range_max).tolist()
-                start = time.thread_time()
-                for _ in range(readings):
-                    p.rayTestBatch(starts, ends, physicsClientId=c)
+                work = functools.partial(p.rayTestBatch, starts, ends, physicsClientId=c)
+
             else:
                 cfg = spec.config
                 view = p.computeViewMatrix(origin, np.add(origin, (1.0, 0.0, 0.0)).tolist(), (0, 0, 1))
+                work = functools.partial(
+                    p.getCameraImage, cfg.width, cfg.height, view, sensor.projection,
+                    renderer=p.ER_TINY_RENDERER, flags=p.ER_NO_SEGMENTATION_MASK, physicsClientId=c,
+                )  # fmt: skip
+
+            spent = 0.0
+            for _ in range(readings):
+                for _ in range(steps):
+                    p.stepSimulation(physicsClientId=c)
                 start = time.thread_time()
-                for _ in range(readings):
-                    p.getCameraImage(
-                        cfg.width, cfg.height, view, sensor.projection, renderer=p.ER_TINY_RENDERER,
-                        flags=p.ER_NO_SEGMENTATION_MASK, physicsClientId=c,
-                    )  # fmt: skip
-            out[spec.name] = (time.thread_time() - start) / (readings / spec.rate)
+                work()
+                spent += time.thread_time() - start
+            out[spec.name] = spent / (readings / spec.rate)
         return out
     finally:
         p.disconnect(c)
@@ -94,10 +110,10 @@ def raw_costs(seconds: float):
 # ---------------------------------------------------------------------------------------------
 # 2. the simulator node
 # ---------------------------------------------------------------------------------------------
-def node_case(n: int, seconds: float, port: int, subscribe, sensors: bool = True):
-    """One launch of n robots: (real-time factor, simulator CPU [s] per simulated second, {sensor: node
-    CPU per simulated second} of robot r0). subscribe: topic suffixes to read on every robot, "all",
-    or ()."""
+def node_case(n: int, seconds: float, port: int, phases, sensors: bool = True):
+    """One launch of n robots, measured in phases one after the other, each reading its own topics:
+    per phase (real-time factor, simulator CPU [s] per simulated second, {sensor: node CPU per
+    simulated second} of robot r0). A phase: topic suffixes to read on every robot, "all", or ()."""
     import rospy  # noqa: PLC0415
     from diagnostic_msgs.msg import DiagnosticArray  # noqa: PLC0415
     from rosgraph_msgs.msg import Clock  # noqa: PLC0415
@@ -125,6 +141,7 @@ def node_case(n: int, seconds: float, port: int, subscribe, sensors: bool = True
     output = tempfile.NamedTemporaryFile("w", prefix="bench_sensors_", suffix=".log", delete=False)
     proc = subprocess.Popen(["roslaunch", launch.name], env=env, stdout=output, stderr=subprocess.STDOUT,
                             start_new_session=True)  # fmt: skip
+    results = []
     try:
         deadline = time.time() + 120 + 20 * n
         while time.time() < deadline and clock["t"] is None:
@@ -132,24 +149,30 @@ def node_case(n: int, seconds: float, port: int, subscribe, sensors: bool = True
                 raise RuntimeError(f"the launch stopped; see {output.name}")
             time.sleep(0.2)
         time.sleep(5.0)  # every robot spawned
-        if subscribe == "all":
-            topics = [t for t, _ in rospy.get_published_topics() if t.startswith("/r") and _sensor_topic(t)]
-        else:
-            topics = [f"/r{k}/{s}" for k in range(n) for s in subscribe]
-        readers = [rospy.Subscriber(t, AnyMsg, lambda _m: None, queue_size=1) for t in topics]
-        time.sleep(3.0)
         sim_pid = [pid for pid in children(proc.pid) if "/simulator" in cmdline(pid).split(" __")[0]]
-        t0, w0, c0 = clock["t"], time.perf_counter(), sum(cpu_seconds(p, 0.0) for p in sim_pid)
-        measuring.set()
-        while clock["t"] - t0 < seconds and time.perf_counter() - w0 < 40 * seconds and proc.poll() is None:
-            time.sleep(0.1)
-        measuring.clear()
-        t1, w1, c1 = clock["t"], time.perf_counter(), sum(cpu_seconds(p, 0.0) for p in sim_pid)
-        simulated = t1 - t0
-        if simulated <= 0:
-            raise RuntimeError(f"simulated time stood still; see {output.name}")
-        sensors_cpu = {k: float(np.median(v)) for k, v in per_sensor.items()}
-        return simulated / (w1 - w0), (c1 - c0) / simulated, sensors_cpu
+        for subscribe in phases:
+            if subscribe == "all":
+                topics = [t for t, _ in rospy.get_published_topics() if t.startswith("/r") and _sensor_topic(t)]
+            else:
+                topics = [f"/r{k}/{s}" for k in range(n) for s in subscribe]
+            readers = [rospy.Subscriber(t, AnyMsg, lambda _m: None, queue_size=1) for t in topics]
+            time.sleep(3.0)
+            per_sensor.clear()
+            t0, w0, c0 = clock["t"], time.perf_counter(), sum(cpu_seconds(p, 0.0) for p in sim_pid)
+            measuring.set()
+            while clock["t"] - t0 < seconds and time.perf_counter() - w0 < 40 * seconds and proc.poll() is None:
+                time.sleep(0.1)
+            measuring.clear()
+            t1, w1, c1 = clock["t"], time.perf_counter(), sum(cpu_seconds(p, 0.0) for p in sim_pid)
+            simulated = t1 - t0
+            if simulated <= 0:
+                raise RuntimeError(f"simulated time stood still; see {output.name}")
+            sensors_cpu = {k: float(np.median(v)) for k, v in per_sensor.items()}
+            results.append((simulated / (w1 - w0), (c1 - c0) / simulated, sensors_cpu))
+            for r in readers:
+                r.unregister()
+            readers = []
+        return results
     finally:
         for r in readers:
             r.unregister()
@@ -177,8 +200,11 @@ def main() -> int:
         port = free_port(11411)
         start_master(procs, log, port, "bench_sensors", master_only=True)
         raw = raw_costs(args.seconds)
-        _, _, in_node = node_case(1, args.seconds, port, "all")
-        print("1. each sensor: CPU per simulated second, raw pybullet and in the simulator node (one robot, all read)")
+        in_node = {}
+        for _, _, cpu in node_case(1, args.seconds, port, [SENSOR_TOPICS[name] for name in raw] + ["all"]):
+            for key, value in cpu.items():  # each sensor from its own phase (read alone); the rest from "all"
+                in_node.setdefault(key, value)
+        print("1. each sensor: CPU per simulated second, raw pybullet and in the simulator node (one robot)")
         print(f"{'sensor':>14} {'raw [s]':>9} {'node [s]':>9} {'node/raw':>9}")
         worst = 0.0
         for name, raw_cpu in raw.items():
@@ -204,7 +230,7 @@ def main() -> int:
         ]
         results = {}
         for label, subscribe, fitted in cases:
-            rtf, cpu, _ = node_case(n, args.seconds, port, subscribe, sensors=fitted)
+            [(rtf, cpu, _)] = node_case(n, args.seconds, port, [subscribe], sensors=fitted)
             results[label] = (rtf, cpu)
             print(f"{label:>36} {rtf:>6.2f}x {cpu:>9.3f}s", flush=True)
         bare, idle = results["no sensors fitted"][1], results["sensors fitted, none read"][1]

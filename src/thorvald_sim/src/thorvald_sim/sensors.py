@@ -31,6 +31,7 @@ robot's and sensor's names, so a run can be repeated.
 """
 
 import math
+import operator
 import zlib
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Tuple
@@ -55,6 +56,7 @@ Quat = Tuple[float, float, float, float]
 Transform = Tuple[Vec3, Quat]
 IDENTITY: Transform = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
+_FRACTION = operator.itemgetter(2)  # of a rayTestBatch result: (object, link, fraction, ...)
 RAY_BATCH = 16384  # pybullet's largest rayTestBatch (MAX_RAY_INTERSECTION_BATCH_SIZE)
 WGS84_A = 6378137.0  # [m] equatorial radius
 WGS84_F = 1.0 / 298.257223563
@@ -156,9 +158,11 @@ class Sensor:
         """(sensor frame in the world, its point's velocity, angular velocity), world axes."""
         pos, quat, com, v, w = self.robot.link_state(self.link_index)
         frame = _compose((pos, quat), self.offset)
-        r = np.asarray(frame[0]) - np.asarray(com)
-        w = np.asarray(w)
-        return frame, np.asarray(v) + np.cross(w, r), w
+        rx, ry, rz = frame[0][0] - com[0], frame[0][1] - com[1], frame[0][2] - com[2]
+        wx, wy, wz = w
+        # v + w x r, in floats: numpy's cross on 3-vectors cost more than the rest of an IMU reading
+        point = (v[0] + wy * rz - wz * ry, v[1] + wz * rx - wx * rz, v[2] + wx * ry - wy * rx)
+        return frame, np.array(point), np.array(w)
 
     def read(self, now: float):
         """A measurement at simulated time now [s] (what it costs is the caller's to count)."""
@@ -202,7 +206,9 @@ class Lidar(Sensor):
         fractions = np.empty(len(d))
         for k in range(0, len(d), RAY_BATCH):
             hits = p.rayTestBatch(starts[k : k + RAY_BATCH], ends[k : k + RAY_BATCH], physicsClientId=self.client)
-            fractions[k : k + len(hits)] = [h[2] if h[0] >= 0 else np.inf for h in hits]
+            # a ray that hits nothing has the fraction 1.0 (and a return at range_max is out of range anyway)
+            fractions[k : k + len(hits)] = np.fromiter(map(_FRACTION, hits), float, len(hits))
+        fractions[fractions >= 1.0] = np.inf
         ranges = c.range_min + fractions * (c.range_max - c.range_min)
         if c.noise_stddev > 0 or c.noise_mean != 0:
             hit = np.isfinite(ranges)
