@@ -58,6 +58,24 @@ def test_sim_launch_with_sensors_fits_the_example_sensors_and_your_extras_win():
     assert "thorvald_001/row_lidar_link" in theirs and "lidar_front_link" not in theirs
 
 
+def test_as_built_reaches_the_spawn_and_never_base_driver():
+    def spawn_args(launch, *args):
+        config = load(os.path.join(BRINGUP, launch), list(args))
+        return {n.namespace + n.name: n.args for n in config.nodes if n.type == "spawn_robot"}, config
+
+    plain, _ = spawn_args("sim.launch")
+    assert "-as_built" not in plain["/thorvald_001/spawn_robot"]
+    built, config = spawn_args("sim.launch", "as_built:=field:3")
+    args = built["/thorvald_001/spawn_robot"].split()
+    model = config.params["/thorvald_001/base_driver/robot_model"].value
+    assert args[args.index("-as_built") + 1] == "field:3" and args[args.index("-robot_model") + 1] == model
+    assert not any("as_built" in name for name in config.params)  # base_driver runs on the configuration
+    fleet, _ = spawn_args("multi_sim.launch", "as_built:=field:9")
+    assert len(fleet) == 4 and all("-as_built field:9" in a for a in fleet.values())
+    report, _ = spawn_args("odometry_report.launch", "as_built:=field:1")
+    assert all("-as_built field:1" in a for a in report.values())
+
+
 def test_multi_sim_launch_has_four_robots_each_placed_in_world():
     config = load(os.path.join(BRINGUP, "multi_sim.launch"))
     for k in range(1, 5):

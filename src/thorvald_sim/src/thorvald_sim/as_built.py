@@ -25,11 +25,14 @@ gives the same robot.
 Pure: no pybullet, no rospy, no messages.
 """
 
+import dataclasses
+import json
 import math
 import random
 from dataclasses import dataclass
 from typing import Any, Dict, List, Mapping, Optional, Tuple
 
+from thorvald_base.can.protocol import DriveScaling
 from thorvald_model.errors import MISSING, ConfigError, Problem
 from thorvald_model.schema import Key, check_top_level, non_negative, parse_entry, parse_scalar, read_yaml_file
 from thorvald_model.values import RobotConfig
@@ -191,6 +194,97 @@ def quantise(angle: float, counts_per_radian: float) -> float:
     return math.trunc(angle * counts_per_radian) / counts_per_radian
 
 
+# ---- what the simulator builds --------------------------------------------------------------
+@dataclass(frozen=True)
+class BuiltDrive:
+    """One drive as the simulator builds and measures it."""
+
+    r_wheel: float  # [m] the wheel's true rolling radius (its collision cylinder)
+    steering_offset: float  # [rad] the wheel's true angle when the controller reads 0
+    steering_count: float = 0.0  # [rad] one steering encoder count; 0: angles reported exactly
+    wheel_count: float = 0.0  # [rad] one propulsion encoder count at the wheel; 0: exactly
+    speed_step: float = 0.0  # [m/s] rim speed of one motor rpm, as the controller reports speed; 0: exactly
+    steering_rate_step: float = 0.0  # [rad/s] steering rate of one steering motor rpm; 0: exactly
+
+    def measured(self, steering: float, speed: float, wheel_angle: float, steering_rate: float):
+        """What the drive's controller reports for the joints' true values: the homing error taken
+        off the steering, then whole encoder counts and whole motor rpm where it counts them."""
+        steering -= self.steering_offset
+        if self.steering_count:
+            steering = quantise(steering, 1.0 / self.steering_count)
+        if self.wheel_count:
+            wheel_angle = quantise(wheel_angle, 1.0 / self.wheel_count)
+        if self.speed_step:
+            speed = round(speed / self.speed_step) * self.speed_step
+        if self.steering_rate_step:
+            steering_rate = round(steering_rate / self.steering_rate_step) * self.steering_rate_step
+        return steering, speed, wheel_angle, steering_rate
+
+
+@dataclass(frozen=True)
+class SimAsBuilt:
+    """An as-built robot resolved for the simulator: per drive in drive order, the true radius, the
+    homing error and the encoders' resolution; the measurement delay and the load. It travels from
+    spawn_robot (which reads the files) to the simulator (which may run on another computer) as
+    JSON in the spawn request."""
+
+    source: str
+    drives: Tuple[BuiltDrive, ...]
+    delay: float = 0.0  # [s]
+    mass_offset: float = 0.0  # [kg]
+
+    def to_json(self) -> str:
+        return json.dumps(
+            {
+                "source": self.source,
+                "drives": [dataclasses.asdict(d) for d in self.drives],
+                "delay": self.delay,
+                "mass_offset": self.mass_offset,
+            }
+        )
+
+    @classmethod
+    def from_json(cls, text: str, drives: Optional[int] = None) -> "SimAsBuilt":
+        """The spawn request's as_built field (for a robot of that many drives, if given); ValueError
+        saying why it cannot be used."""
+        try:
+            data = json.loads(text)
+            built = cls(
+                str(data["source"]),
+                tuple(BuiltDrive(**{k: float(v) for k, v in d.items()}) for d in data["drives"]),
+                float(data["delay"]),
+                float(data["mass_offset"]),
+            )
+        except (ValueError, TypeError, KeyError) as e:
+            raise ValueError(f"the as-built robot is not readable ({type(e).__name__}: {e})") from None
+        values = [built.delay, built.mass_offset] + [v for d in built.drives for v in dataclasses.astuple(d)]
+        if drives is not None and len(built.drives) != drives:
+            raise ValueError(f"the as-built robot has {len(built.drives)} drives, the description {drives}")
+        if not all(math.isfinite(v) for v in values) or any(d.r_wheel <= 0 for d in built.drives):
+            raise ValueError("the as-built robot's values must be finite, its radii > 0")
+        return built
+
+
+def for_simulator(as_built: AsBuilt, config: RobotConfig) -> SimAsBuilt:
+    """What the simulator needs of an as-built robot of config. The encoders count as the CAN
+    codec's scalings say (thorvald_base.can.protocol.DriveScaling): steering in quadrature counts of
+    str_enc_ppr through str_gr_rt, the wheel in counts of prp_enc_ppr through prp_gr_rt, speeds in
+    whole motor rpm, with the configured radius, as the controllers and base_driver convert them."""
+    drives = []
+    for built, drive in zip(as_built.drives, config.drives):
+        counts = {}
+        if as_built.encoders:
+            scaling = DriveScaling.of(drive)
+            counts = {
+                "steering_count": 1.0 / scaling.counts_per_radian if drive.steerable else 0.0,
+                "wheel_count": 1.0 / scaling.wheel_counts_per_radian,
+                "speed_step": scaling.wheel_speed(1.0),
+                "steering_rate_step": scaling.steering_rate(1.0) if drive.steerable else 0.0,
+            }
+        drives.append(BuiltDrive(built.r_wheel, built.steering_offset, **counts))
+    return SimAsBuilt(as_built.source, tuple(drives), as_built.delay, as_built.mass_offset)
+
+
 def _name(index: int) -> str:
     return f"drive{index}"
 
@@ -224,11 +318,14 @@ def _drive_entries(raw: Any, config: RobotConfig, problems: List[Problem]) -> Di
 __all__ = [
     "PROFILES",
     "AsBuilt",
+    "BuiltDrive",
     "DriveAsBuilt",
     "Profile",
+    "SimAsBuilt",
     "as_built_for",
     "as_configured",
     "draw_as_built",
+    "for_simulator",
     "load_as_built",
     "parse_as_built",
     "quantise",

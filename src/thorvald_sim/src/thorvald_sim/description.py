@@ -11,7 +11,7 @@ wheels) with their friction. A URDF without the block (any other robot) is a pas
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Callable, Dict, Iterable, Optional, Tuple
+from typing import Callable, Dict, Iterable, Mapping, Optional, Tuple
 
 from thorvald_model.datum import Datum, parse_datum
 from thorvald_model.errors import ConfigError
@@ -232,6 +232,21 @@ def with_tyre_contact(xml: str, wheel_joints: Iterable[str], width: float) -> st
             continue
         for cylinder in link.findall("collision/geometry/cylinder"):
             cylinder.set("length", repr(min(float(cylinder.get("length")), width)))
+    return ET.tostring(root, encoding="unicode")
+
+
+def with_wheel_radii(xml: str, radii: Mapping[str, float]) -> str:
+    """The URDF with the collision cylinders of the given wheels' links ({wheel joint: radius [m]})
+    of another radius: an as-built robot's true rolling radii. The visuals, masses and inertias, and
+    what the description says of the drives, stay as configured."""
+    if not radii:
+        return xml
+    root = ET.fromstring(xml)
+    links = {j.find("child").get("link"): radii[j.get("name")] for j in root.findall("joint") if j.get("name") in radii}
+    for link in root.findall("link"):
+        if link.get("name") in links:
+            for cylinder in link.findall("collision/geometry/cylinder"):
+                cylinder.set("radius", repr(links[link.get("name")]))
     return ET.tostring(root, encoding="unicode")
 
 

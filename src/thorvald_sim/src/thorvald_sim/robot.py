@@ -22,6 +22,11 @@ No ROS here: the simulator node converts messages. The pybullet client id is pas
   bodies') is the world surface's, and no velocity damping (pybullet's default drag of 0.04 /s).
 * Ground truth is base_link's pose and twist: pybullet reports the base's centre of mass, so the
   URDF's inertial offset (all merged modules' centre of mass) is composed out.
+* As built (:mod:`thorvald_sim.as_built`, optional): wheels of their true rolling radii (the
+  collision cylinders; the controllers still convert with the configured radius, as real ones do),
+  steering modules homed off by their offsets (a command of a goes to a + offset, a measured a + offset
+  reads a), the encoders' whole counts and whole motor rpm in what is reported, measurements reported
+  ``delay`` late (the newest one at least that old), and a load of ``mass_offset`` on the frame.
 """
 
 import contextlib
@@ -29,6 +34,7 @@ import math
 import os
 import sys
 import tempfile
+from collections import deque
 from dataclasses import dataclass
 from typing import List, Optional, Sequence, Tuple
 
@@ -36,7 +42,8 @@ import pybullet as p
 
 from thorvald_base.bases import MeasuredDrive
 
-from .description import DescriptionError, RobotDescription, with_tyre_contact
+from .as_built import BuiltDrive, SimAsBuilt
+from .description import DescriptionError, RobotDescription, with_tyre_contact, with_wheel_radii
 
 LOAD_FLAGS = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER | p.URDF_MERGE_FIXED_LINKS
 LINK_FRICTION = 1.0
@@ -69,7 +76,17 @@ class SimRobot:
         pose: Pose2D,
         *,
         tyre_contact_width: float = TYRE_CONTACT_WIDTH,
+        as_built: Optional[SimAsBuilt] = None,
     ):
+        if as_built is not None and len(as_built.drives) != len(description.drives):
+            raise DescriptionError(
+                f"the as-built robot has {len(as_built.drives)} drives, the description {len(description.drives)}"
+            )
+        self.as_built = as_built
+        self.built: List[BuiltDrive] = (
+            list(as_built.drives) if as_built else [BuiltDrive(d.wheel_radius, 0.0) for d in description.drives]
+        )
+        self._history = deque()  # (time, drive states) measured, while reports are delayed
         self.client = client
         self.name = name
         self.description = description
@@ -80,8 +97,11 @@ class SimRobot:
         self.sensor_problems = []  # sensors that could not be mounted
         wheels = [d.wheel_joint for d in description.drives]
         wheels += [j.name for j in description.passive_joints if j.name.endswith("wheel")]
+        radii = {
+            d.wheel_joint: b.r_wheel for d, b in zip(description.drives, self.built) if b.r_wheel != d.wheel_radius
+        }
         with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
-            f.write(with_tyre_contact(urdf, wheels, tyre_contact_width))
+            f.write(with_tyre_contact(with_wheel_radii(urdf, radii), wheels, tyre_contact_width))
         try:
             orientation = p.getQuaternionFromEuler((0.0, 0.0, pose.yaw))
             with _quiet_stdout():
@@ -95,6 +115,9 @@ class SimRobot:
         self.joint_index = {}
         for j in range(p.getNumJoints(self.body, physicsClientId=client)):
             self.joint_index[p.getJointInfo(self.body, j, physicsClientId=client)[1].decode()] = j
+        if as_built is not None and as_built.mass_offset > 0:  # a load at the frame's centre of mass
+            mass = p.getDynamicsInfo(self.body, -1, physicsClientId=client)[0]
+            p.changeDynamics(self.body, -1, mass=mass + as_built.mass_offset, physicsClientId=client)
         dyn = p.getDynamicsInfo(self.body, -1, physicsClientId=client)
         self._inertial = (tuple(dyn[3]), tuple(dyn[4]))  # centre of mass in base_link
         self._to_base_link = p.invertTransform(*self._inertial)
@@ -177,7 +200,7 @@ class SimRobot:
                 body,
                 joint,
                 p.POSITION_CONTROL,
-                targetPosition=steering[k],
+                targetPosition=steering[k] + self.built[k].steering_offset,
                 force=effort,
                 maxVelocity=speed if speed > 0 else 100.0,
                 positionGain=STEERING_POSITION_GAIN,
@@ -206,8 +229,8 @@ class SimRobot:
 
     def hold(self) -> None:
         """Wheels stopped (their motors brake), steering held where it is."""
-        states = self.drive_states()
-        self.command([s.steering for s in states], [0.0] * len(states))
+        states = self._joint_drive_states()
+        self.command([s.steering - b.steering_offset for s, b in zip(states, self.built)], [0.0] * len(states))
 
     def apply_springs(self) -> None:
         """The suspension's spring and damper forces for the next step (called before every step)."""
@@ -220,8 +243,27 @@ class SimRobot:
         p.setJointMotorControlArray(body, joints, p.TORQUE_CONTROL, forces=forces, physicsClientId=c)
 
     # ---- measurements -------------------------------------------------------------------------
-    def drive_states(self) -> List[MeasuredDrive]:
-        """What each drive's encoders measure: steering angle and rate, wheel angle and rim speed."""
+    def drive_states(self, now: Optional[float] = None) -> List[MeasuredDrive]:
+        """What each drive's encoders measure: steering angle and rate, wheel angle and rim speed (the
+        configured radius times the wheel's turning rate, as the controller converts it). As built:
+        through each drive's homing error and encoder counts, and, with a delay, the newest
+        measurement taken at least that long before now [s] (simulated time)."""
+        if self.as_built is None:
+            return self._joint_drive_states()
+        states = [
+            MeasuredDrive(*b.measured(s.steering, s.speed, s.wheel_angle, s.steering_speed))
+            for s, b in zip(self._joint_drive_states(), self.built)
+        ]
+        if self.as_built.delay <= 0 or now is None:
+            return states
+        history = self._history
+        history.append((now, states))
+        while len(history) > 1 and history[1][0] <= now - self.as_built.delay + 1e-9:  # 1 ns: rounding
+            history.popleft()
+        return history[0][1]
+
+    def _joint_drive_states(self) -> List[MeasuredDrive]:
+        """The drives' joints as they are (no encoder, no delay, no homing error)."""
         c, body = self.client, self.body
         out = []
         for (wheel, _, radius), steer in zip(self.wheels, self.steering):
@@ -287,6 +329,7 @@ class SimRobot:
         p.resetBaseVelocity(self.body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=c)
         for j in self.joint_index.values():
             p.resetJointState(self.body, j, 0.0, 0.0, physicsClientId=c)
+        self._history.clear()
         self.hold()
 
     def remove(self) -> None:

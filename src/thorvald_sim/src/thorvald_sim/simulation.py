@@ -11,6 +11,7 @@ from typing import Dict, Optional, Tuple
 import numpy as np
 import pybullet as p
 
+from .as_built import SimAsBuilt
 from .description import DescriptionError, MeshFinder, mesh_finder, parse_description, resolve_meshes
 from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
 from .scene import build_scene
@@ -78,14 +79,15 @@ class Simulation:
         self.steps = 0
         self.solver_cpu = 0.0  # [s] of this thread's CPU time spent in pybullet's stepSimulation, all steps
 
-    def spawn(self, name: str, urdf: str, pose: Pose2D) -> SimRobot:
+    def spawn(self, name: str, urdf: str, pose: Pose2D, as_built: Optional[SimAsBuilt] = None) -> SimRobot:
         """Loads a robot; SpawnError (the world unchanged) if the name is taken or the URDF unusable.
 
         Mesh files are resolved first; the elements whose mesh cannot be found are left out and
         listed in the robot's ``missing_meshes``, for the caller to say so. The description's Gazebo
         sensor blocks become the robot's ``sensors`` (:mod:`thorvald_sim.sensors`); what is not
         simulated and what is refused is in ``sensor_blocks`` and ``sensor_problems``, for the
-        caller to say so too. The robot spawns whatever its sensor blocks hold.
+        caller to say so too. The robot spawns whatever its sensor blocks hold. as_built: the robot
+        as built (:mod:`thorvald_sim.as_built`), None for as configured.
         """
         if not name:
             raise SpawnError("a robot needs a name")
@@ -94,7 +96,15 @@ class Simulation:
         try:
             description = parse_description(urdf)
             urdf, missing = resolve_meshes(urdf, self.find_mesh)
-            robot = SimRobot(self.client, name, description, urdf, pose, tyre_contact_width=self.tyre_contact_width)
+            robot = SimRobot(
+                self.client,
+                name,
+                description,
+                urdf,
+                pose,
+                tyre_contact_width=self.tyre_contact_width,
+                as_built=as_built,
+            )
         except DescriptionError as e:
             raise SpawnError(f"{name}: {e}") from None
         robot.missing_meshes = missing

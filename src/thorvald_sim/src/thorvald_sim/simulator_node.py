@@ -73,6 +73,7 @@ from thorvald_msgs.srv import (
     SpawnRobotResponse,
 )
 
+from .as_built import SimAsBuilt
 from .robot import Pose2D
 from .sensor_io import RobotSensors
 from .sensors import sensor_report
@@ -291,9 +292,16 @@ class SimulatorNode:
         pose = Pose2D(req.x, req.y, req.z, req.yaw)
         if not all(math.isfinite(v) for v in (req.x, req.y, req.z, req.yaw)):
             return SpawnRobotResponse(False, f"{req.model_name}: the spawn pose must be finite")
+        as_built = None
+        if req.as_built:
+            try:
+                as_built = SimAsBuilt.from_json(req.as_built)  # its drives are counted at the spawn
+            except ValueError as e:
+                rospy.logerr("simulator: refused to spawn %s: %s", req.model_name, e)
+                return SpawnRobotResponse(False, f"{req.model_name}: {e}")
         with self.lock:
             try:
-                robot = self.sim.spawn(req.model_name, req.robot_description, pose)
+                robot = self.sim.spawn(req.model_name, req.robot_description, pose, as_built)
             except SpawnError as e:
                 rospy.logerr("simulator: refused to spawn: %s", e)
                 return SpawnRobotResponse(False, str(e))
@@ -313,6 +321,8 @@ class SimulatorNode:
             self.io[req.model_name] = RobotIO(self, robot, req.robot_namespace, topic, tf)
         kind = f"{len(robot.wheels)} drives following {topic}" if robot.wheels else "passive (no drive block)"
         message = f"spawned {req.model_name} in {req.robot_namespace or '/'} at ({req.x:g}, {req.y:g}), {kind}"
+        if as_built is not None:
+            message += f", as built: {as_built.source}"
         rospy.loginfo("simulator: %s", message)
         return SpawnRobotResponse(True, message)
 

@@ -12,6 +12,9 @@ is that namespace's parameter, and the robot's topics live there.
   -gazebo_namespace S    the simulator node (default /simulator); -simulator S is the same
   -command_topic T       follow T instead of the description's (base_state)
   -publish_tf / -no_publish_tf   odom -> base_link from ground truth (default: the simulator's ~publish_tf)
+  -as_built SPEC         build the robot as an as-built file says, or a profile drawn with a seed
+                         (field:7); needs -robot_model (thorvald_sim.as_built). base_driver never sees it
+  -robot_model FILE      the robot's configuration file (what the as-built robot differs from)
   -unpause               unpause the simulation after spawning
   -timeout T             seconds to wait for the simulator (default 60)
 
@@ -25,7 +28,10 @@ from typing import List, Optional
 import rospy
 from std_srvs.srv import Empty
 
+from thorvald_model import ConfigError, load_robot_config
 from thorvald_msgs.srv import SpawnRobot
+
+from .as_built import as_built_for, for_simulator
 
 
 def parse_args(argv: List[str]) -> argparse.Namespace:
@@ -43,6 +49,8 @@ def parse_args(argv: List[str]) -> argparse.Namespace:
     tf = parser.add_mutually_exclusive_group()
     tf.add_argument("-publish_tf", dest="publish_tf", action="store_const", const=1, default=-1)
     tf.add_argument("-no_publish_tf", dest="publish_tf", action="store_const", const=0)
+    parser.add_argument("-as_built", default="")
+    parser.add_argument("-robot_model", default="")
     parser.add_argument("-unpause", action="store_true")
     parser.add_argument("-timeout", type=float, default=60.0)
     return parser.parse_args(argv)
@@ -66,6 +74,17 @@ def read_description(args) -> str:
     return xml
 
 
+def read_as_built(args) -> str:
+    """The spawn request's as_built field: "" (as configured) or the resolved as-built robot as JSON;
+    ConfigError (file, key path, value, rule) or RuntimeError saying what is wrong."""
+    if not args.as_built:
+        return ""
+    if not args.robot_model:
+        raise RuntimeError("-as_built needs -robot_model: the configuration the built robot differs from")
+    config = load_robot_config(args.robot_model)
+    return for_simulator(as_built_for(args.as_built, config), config).to_json()
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     rospy.init_node("spawn_robot", anonymous=True)
     args = parse_args(rospy.myargv(argv if argv is not None else sys.argv)[1:])
@@ -74,7 +93,8 @@ def main(argv: Optional[List[str]] = None) -> int:
         return 1
     try:
         xml = read_description(args)
-    except RuntimeError as e:
+        as_built = read_as_built(args)
+    except (RuntimeError, ConfigError) as e:
         print(f"spawn_robot: {e}", file=sys.stderr)
         return 1
     simulator = args.simulator.rstrip("/")
@@ -85,7 +105,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         return 1
     namespace = args.robot_namespace if args.robot_namespace is not None else rospy.get_namespace()
     response = rospy.ServiceProxy(simulator + "/spawn_robot", SpawnRobot)(
-        args.model, namespace, xml, args.x, args.y, args.z, args.Y, args.command_topic, args.publish_tf
+        args.model, namespace, xml, args.x, args.y, args.z, args.Y, args.command_topic, args.publish_tf, as_built
     )
     if not response.success:
         print(f"spawn_robot: {response.message}", file=sys.stderr)

@@ -41,7 +41,7 @@ class SimFleetTest(unittest.TestCase):
         sim_sleep(SECONDS / 2)
         spawn = rospy.ServiceProxy("/simulator/spawn_robot", SpawnRobot)
         cls.refused = spawn(
-            "broken", "/broken", "<robot name='broken'><link name='a'/><joint", 9.0, 9.0, 0.0, 0.0, "", -1
+            "broken", "/broken", "<robot name='broken'><link name='a'/><joint", 9.0, 9.0, 0.0, 0.0, "", -1, ""
         )
         cls.mid = {r: planar(cls.truth[r].get()) for r in cls.robots}
         cls.mid_twist = {r: cls.truth[r].get().twist.twist for r in cls.robots}

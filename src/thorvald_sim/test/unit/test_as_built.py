@@ -10,9 +10,11 @@ from thorvald_base.can.protocol import DriveScaling
 from thorvald_model import load_robot_config
 from thorvald_model.errors import ConfigError
 from thorvald_sim.as_built import (
+    SimAsBuilt,
     as_built_for,
     as_configured,
     draw_as_built,
+    for_simulator,
     load_as_built,
     parse_as_built,
     quantise,
@@ -26,6 +28,7 @@ def robot(name):
     return load_robot_config(os.path.join(CONFIGS, name, name + ".yaml"))
 
 
+STD_PATH = os.path.join(CONFIGS, "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
 STD = robot("thorvald_ii_4wd4ws_std")  # four steered drives, r_wheel 0.2 ... as configured
 DIFF = robot("thorvald_ii_2wd_diff")  # two drives that do not steer
 
@@ -139,3 +142,45 @@ def test_quantisation_in_whole_counts_of_the_configured_encoders():
     for angle in (0.1, 0.33, -1.2):
         q = quantise(angle, per_radian)
         assert abs(angle - q) < step and round(q * per_radian) == pytest.approx(q * per_radian)
+
+
+def test_the_simulator_gets_radii_offsets_and_the_encoders_resolution():
+    built = for_simulator(draw_as_built("field:5", STD), STD)
+    drawn = draw_as_built("field:5", STD)
+    assert [d.r_wheel for d in built.drives] == [d.r_wheel for d in drawn.drives]
+    assert [d.steering_offset for d in built.drives] == [d.steering_offset for d in drawn.drives]
+    scaling = DriveScaling.of(STD.drives[0])  # the CAN codec's: what the controllers count
+    d = built.drives[0]
+    assert d.steering_count == pytest.approx(1.0 / scaling.counts_per_radian)
+    assert d.wheel_count == pytest.approx(2 * math.pi / (STD.drives[0].prp_enc_ppr * 4 * STD.drives[0].prp_gr_rt))
+    assert d.speed_step == pytest.approx(scaling.wheel_speed(1.0))
+    # what a controller reports: the homing error off, whole counts, whole rpm
+    steering, speed, wheel, rate = d.measured(0.3, 0.5, 12.0, 0.2)
+    assert steering == pytest.approx(0.3 - d.steering_offset, abs=d.steering_count)
+    assert steering / d.steering_count == pytest.approx(round(steering / d.steering_count))
+    assert speed / d.speed_step == pytest.approx(round(speed / d.speed_step)) and abs(speed - 0.5) <= d.speed_step / 2
+    assert wheel / d.wheel_count == pytest.approx(round(wheel / d.wheel_count))
+    assert rate / d.steering_rate_step == pytest.approx(round(rate / d.steering_rate_step))
+    # without encoders, exactly what the joints say less the homing error
+    exact = for_simulator(parse_as_built({"motor_drives": {"drive0": {"steering_offset": 0.01}}}, STD), STD)
+    assert exact.drives[0].measured(0.3, 0.5, 12.0, 0.2) == (pytest.approx(0.29), 0.5, 12.0, 0.2)
+    # a drive that does not steer counts no steering
+    assert all(d.steering_count == 0 for d in for_simulator(draw_as_built("field:1", DIFF), DIFF).drives)
+
+
+def test_spawn_robot_reads_the_as_built_robot(tmp_path):
+    import argparse  # noqa: PLC0415
+
+    from thorvald_sim.spawn_robot import read_as_built  # noqa: PLC0415
+
+    def args(as_built, robot_model=STD_PATH):
+        return argparse.Namespace(as_built=as_built, robot_model=robot_model)
+
+    assert read_as_built(args("")) == ""
+    assert SimAsBuilt.from_json(read_as_built(args("field:2"))) == for_simulator(draw_as_built("field:2", STD), STD)
+    with pytest.raises(RuntimeError, match="needs -robot_model"):
+        read_as_built(args("field:2", ""))
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("motor_drives:\n  drive9: {r_wheel: 0.2}\n")
+    with pytest.raises(ConfigError, match="drive9"):
+        read_as_built(args(str(bad)))

@@ -139,7 +139,7 @@ class DriveScaling:
     """A drive's conversions between physical units and the controller's numbers.
 
     From the configuration: ``r_wheel``, ``prp_gr_rt``, ``prp_max_rpm``, ``str_gr_rt``,
-    ``str_enc_ppr``, ``str_lim`` (the reference's section 8).
+    ``str_enc_ppr``, ``str_lim`` (the reference's section 8), ``prp_enc_ppr``.
     """
 
     r_wheel: float  # [m]
@@ -148,11 +148,20 @@ class DriveScaling:
     str_gr_rt: float
     str_enc_ppr: int
     str_lim: float  # [rad] at a steering command of 1000
+    prp_enc_ppr: int = 1024  # propulsion encoder pulses per motor revolution
 
     @classmethod
     def of(cls, drive) -> "DriveScaling":
         """For a thorvald_model.config.Drive."""
-        return cls(drive.r_wheel, drive.prp_gr_rt, drive.prp_max_rpm, drive.str_gr_rt, drive.str_enc_ppr, drive.str_lim)
+        return cls(
+            drive.r_wheel,
+            drive.prp_gr_rt,
+            drive.prp_max_rpm,
+            drive.str_gr_rt,
+            drive.str_enc_ppr,
+            drive.str_lim,
+            drive.prp_enc_ppr,
+        )
 
     # propulsion
     def motor_rpm(self, speed: float) -> float:
@@ -162,6 +171,11 @@ class DriveScaling:
     def wheel_speed(self, motor_rpm: float) -> float:
         """Wheel rim speed [m/s] for a motor rpm."""
         return motor_rpm / self.prp_gr_rt * math.pi / 30.0 * self.r_wheel
+
+    @property
+    def wheel_counts_per_radian(self) -> float:
+        """Propulsion encoder counts (quadrature, x4) per radian of the wheel."""
+        return self.prp_enc_ppr * 4 * self.prp_gr_rt / (2.0 * math.pi)
 
     def prop_command(self, speed: float) -> int:
         """RxPDO1's prop_cmd: motor rpm scaled so that +-1000 = +-prp_max_rpm, clamped to +-1000."""
