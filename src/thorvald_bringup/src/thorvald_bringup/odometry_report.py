@@ -1,7 +1,9 @@
 """The paper's odometry verification (section 3.3.2), as numbers: pure, from recorded series.
 
 A drive is recorded as the commands, base_driver's odometry (``odometry/base_raw``), ground truth
-(``odometry/gazebo``) and base_driver's measured drive states (``base_state``). Both odometry
+(``odometry/gazebo``) and base_driver's measured drive states (``base_state``), and, as the paper
+measured it, an RTK-GNSS fix (``gps/fix``, 10 Hz, 2 cm) and the IMU's yaw (``imu/data``): the report
+gives odometry's figures against both, the simulator's true pose and RTK-GNSS. Both odometry
 estimators are replayed from the same drive states through the calculator base_driver uses (the
 one of thorvald_base, loaded by its plugin name), so they are compared on one drive; the replayed
 ``lsq`` must agree with what base_driver published live, which checks the replay itself.
@@ -26,6 +28,16 @@ PAPER_END_POINT_DIFFERENCE = 2.2  # [m]
 PAPER_DURATION = 77.0  # [s]
 PAPER_SEED = 0  # the paper estimator's random pairs, for a reproducible report
 REST = 1.5  # [s] after the last command: base_driver's wheels have ramped down
+# Against RTK-GNSS, distances are measured of every path alike: at the fixes' instants, averaged over
+# GNSS_SMOOTHING consecutive ones (0.5 s at 10 Hz), between points at least GNSS_SPACING [m] apart. Summed
+# between raw consecutive fixes (0.1 m apart at 1 m/s), 2 cm of noise per axis adds 0.0008 / (2 d)
+# to each d: +4 %, and a robot standing still would seem to move. Averaged over 5, two neighbours
+# differ by noise of 2 x 0.0004 / 25 per axis: +0.16 % a 0.1 m step; the spacing keeps a standing
+# robot still and cuts corners by at most 0.1 (sqrt 2 - 1) = 0.04 m a right angle.
+GNSS_SPACING = 0.1
+GNSS_SMOOTHING = 5
+WGS84_A = 6378137.0  # [m]
+WGS84_E2 = 2 * (1 / 298.257223563) - (1 / 298.257223563) ** 2
 SHORT_DRIVE = 0.97  # ground truth below this share of the planned distance: the drive fell behind
 
 
@@ -60,6 +72,7 @@ class Recording:
     states: List[Tuple[float, Tuple[float, ...], Tuple[float, ...]]]  # (t, steering [rad], rim speed [m/s])
     robot: str = ""
     source: str = ""  # the bag file
+    gnss: Path = field(default_factory=Path)  # RTK-GNSS positions with the IMU's yaw (gnss_path); may be empty
 
 
 @dataclass(frozen=True)
@@ -82,6 +95,7 @@ class Report:
     replay_agreement: float  # [m] largest distance between replayed lsq and base_driver's odometry
     planned_distance: float = math.nan  # [m] of the manoeuvre's plan, when the recording drove it
     missing_states: int = 0  # base_driver cycles with odometry but no base_state in the recording
+    figures_gnss: dict = field(default_factory=dict)  # name -> Figures against RTK-GNSS (when recorded)
 
 
 class ReportError(ValueError):
@@ -143,14 +157,81 @@ def path_length(path: Path) -> float:
     return sum(math.hypot(x1 - x0, y1 - y0) for x0, y0, x1, y1 in zip(path.x, path.y, path.x[1:], path.y[1:]))
 
 
-def figures_of(path: Path, truth: Path) -> Figures:
-    d, dt = path_length(path), path_length(truth)
+def figures_of(path: Path, truth: Path, length=path_length) -> Figures:
+    """path's figures against truth; length: how a path's distance is measured (of both)."""
+    d, dt = length(path), length(truth)
     return Figures(
         d,
         (d - dt) / dt * 100.0 if path is not truth and dt > 0 else math.nan,
         math.hypot(path.x[-1] - truth.x[-1], path.y[-1] - truth.y[-1]),
         math.remainder(path.yaw[-1] - truth.yaw[-1], 2 * math.pi),
     )
+
+
+def spaced_length(path: Path, spacing: float = GNSS_SPACING) -> float:
+    """A noisy path's length between points at least spacing [m] apart (and its last point)."""
+    if not len(path):
+        return 0.0
+    total, kx, ky = 0.0, path.x[0], path.y[0]
+    for x, y in zip(path.x, path.y):
+        d = math.hypot(x - kx, y - ky)
+        if d >= spacing:
+            total, kx, ky = total + d, x, y
+    return total + math.hypot(path.x[-1] - kx, path.y[-1] - ky)
+
+
+def gnss_local(
+    latitude: float, longitude: float, lat0: float, lon0: float, heading: float = 0.0
+) -> Tuple[float, float]:
+    """A fix [deg] as (x, y) [m] of the simulator's world about (lat0, lon0): hector_gazebo_plugins'
+    mapping inverted (its x along the reference heading [deg], y to the left of it: with heading 0,
+    x north and y west), with the WGS84 radii of curvature at lat0."""
+    lat = math.radians(lat0)
+    temp = 1.0 / (1.0 - WGS84_E2 * math.sin(lat) ** 2)
+    prime_vertical = WGS84_A * math.sqrt(temp)
+    north = math.radians(latitude - lat0) * prime_vertical * (1.0 - WGS84_E2) * temp
+    west = -math.radians(longitude - lon0) * prime_vertical * math.cos(lat)
+    h = math.radians(heading)
+    return math.cos(h) * north - math.sin(h) * west, math.sin(h) * north + math.cos(h) * west
+
+
+def gnss_path(
+    fixes: Sequence[Tuple[float, float, float]], yaws: Sequence[Tuple[float, float]], heading: float = 0.0
+) -> Path:
+    """RTK-GNSS as a path: fixes (t, latitude, longitude) in metres about the first one (gnss_local), each
+    with the yaw of the IMU's latest reading (t, yaw) at or before it; no twist. The antenna is taken
+    to stand over base_link (odometry_report.launch mounts it there)."""
+    path = Path()
+    if not fixes or not yaws:
+        return path
+    _, lat0, lon0 = fixes[0]
+    times = [t for t, _ in yaws]
+    for t, lat, lon in fixes:
+        i = bisect.bisect_right(times, t) - 1
+        if i < 0:
+            continue
+        path.append(t, (*gnss_local(lat, lon, lat0, lon0, heading), yaws[i][1]), (0.0, 0.0, 0.0))
+    return path
+
+
+def resampled(path: Path, times: Sequence[float]) -> Path:
+    """The path's poses at the given times (each the last sample at or before it)."""
+    out = Path()
+    for t in times:
+        out.append(t, pose_at(path, t), (0.0, 0.0, 0.0))
+    return out
+
+
+def smoothed(path: Path, window: int = GNSS_SMOOTHING) -> Path:
+    """The path with each position the mean of window consecutive ones centred on it (fewer at the ends)."""
+    out = Path()
+    n, half = len(path), window // 2
+    for i in range(n):
+        lo, hi = max(0, i - half), min(n, i + half + 1)
+        x = sum(path.x[lo:hi]) / (hi - lo)
+        y = sum(path.y[lo:hi]) / (hi - lo)
+        out.append(path.t[i], (x, y, path.yaw[i]), (path.vx[i], path.vy[i], path.wz[i]))
+    return out
 
 
 def make_report(recording: Recording, calculators: dict) -> Report:
@@ -186,6 +267,16 @@ def make_report(recording: Recording, calculators: dict) -> Report:
     agreement = _largest_gap(replayed["lsq"], paths["odometry lsq"]) if "lsq" in replayed else math.nan
     figures = {name: figures_of(path, truth) for name, path in paths.items()}
     report = Report(recording, start, end, paths, figures, agreement)
+    if len(recording.gnss) and recording.gnss.t[0] <= start:
+        gnss = aligned(recording.gnss, start, end)
+        report.paths["RTK-GNSS"] = gnss
+
+        def length(p: Path) -> float:  # every path as the fixes see it: at their instants, averaged, spaced
+            return spaced_length(smoothed(p if p is gnss else resampled(p, gnss.t)))
+
+        report.figures_gnss = {
+            name: figures_of(path, gnss, length) for name, path in (("RTK-GNSS", gnss), *paths.items())
+        }
     # a loaded machine may drop messages on the way to rosbag; the replay then differs where they are missing
     report.missing_states = len(set(recording.odometry.t) - {s[0] for s in recording.states})
     return report
@@ -249,6 +340,22 @@ def format_report(report: Report, targets: Optional[Tuple[float, float]] = None)
                 "commands fell behind the simulator, base_driver stopped the wheels at its command timeout "
                 "(a loaded machine: try --real-time-factor 2)"
             )
+    g = report.figures_gnss
+    if g:
+        names = [n for n in ("RTK-GNSS", "ground truth", "odometry lsq", "odometry paper") if n in g]
+        lines += [
+            f"  against RTK-GNSS (10 Hz, 2 cm) and the IMU's yaw, as the paper measured (distances between "
+            f"points {GNSS_SPACING:g} m apart, the fixes averaged over {GNSS_SMOOTHING}):",
+            f"{'':30}" + "".join(f"{n:>16}" for n in names),
+        ]
+        for label, fmt, getter in (
+            ("distance [m]", ".2f", lambda v: v.distance),
+            ("distance error [%]", "+.2f", lambda v: v.distance_error),
+            ("end-point difference [m]", ".3f", lambda v: v.end_point_difference),
+            ("heading at the end [deg]", "+.2f", lambda v: math.degrees(v.heading_difference)),
+        ):
+            cells = [math.nan if (n == "RTK-GNSS" and label != "distance [m]") else getter(g[n]) for n in names]
+            lines.append(f"  {label:28}" + "".join(f"{'-' if math.isnan(c) else format(c, fmt):>16}" for c in cells))
     if targets is not None and "odometry lsq" in f:
         err, end = targets
         lsq = f["odometry lsq"]

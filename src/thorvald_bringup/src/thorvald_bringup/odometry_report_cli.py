@@ -20,6 +20,7 @@ import time
 
 from thorvald_model import ConfigError, load_robot_config
 from thorvald_model.ports import free_port
+from thorvald_sim.as_built import PROFILES, as_built_for, describe_as_built
 
 TARGET_DISTANCE_ERROR = 0.5  # [%] for lsq (the paper: 1.0 %)
 TARGET_END_POINT = 1.0  # [m] for lsq (the paper: 2.2 m)
@@ -41,6 +42,13 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--bag", metavar="FILE", help="report from this bag instead of driving")
     p.add_argument("--plan", action="store_true", help="with --bag: the bag is of the verification manoeuvre")
     p.add_argument("--world", default="tarmac_gravel", help="the simulator's world (default tarmac_gravel)")
+    p.add_argument(
+        "--as-built",
+        metavar="FILE|PROFILE:SEED",
+        default="",
+        help="drive the robot as built: an as-built file or a profile drawn with a seed (field:3); base_driver "
+        "runs on the configuration, as on a real robot (default: built as configured)",
+    )
     p.add_argument(
         "--out",
         metavar="DIR",
@@ -83,12 +91,14 @@ def drive(args, model: str, bag: str) -> float:
         f"bag:={bag}",
         f"real_time_factor:={args.real_time_factor:g}",
         f"with_gui:={'true' if args.gui else 'false'}",
+        f"as_built:={args.as_built}",
     ]
     for stale in (bag, bag + ".active"):
         if os.path.exists(stale):
             os.remove(stale)
     print(
-        f"Driving {os.path.basename(model)[:-5]} through the verification manoeuvre on {args.world} "
+        f"Driving {os.path.basename(model)[:-5]}{' as built ' + args.as_built if args.as_built else ''} through the "
+        f"verification manoeuvre on {args.world} "
         f"(simulator, measured drives, ROS master on port {port}; log {log})",
         flush=True,
     )
@@ -121,6 +131,9 @@ def main(argv=None) -> int:
     try:
         model = robot_file(args)
         config = load_robot_config(model)
+        built = as_built_for(args.as_built, config)  # refused here, before anything starts
+        if args.as_built and args.as_built.partition(":")[0] not in PROFILES:
+            args.as_built = os.path.abspath(args.as_built)  # the spawn runs elsewhere (in ~/.ros)
     except ConfigError as e:
         print(e, file=sys.stderr)  # FILE: key path: value: rule, as every command that reads a robot file
         return 2
@@ -168,6 +181,8 @@ def main(argv=None) -> int:
         return 1
     print()
     print(format_report(report, (TARGET_DISTANCE_ERROR, TARGET_END_POINT)))
+    if args.as_built:
+        print(f"  as built ({args.as_built}): {describe_as_built(built)}")
     if wall is not None:
         simulated = recording.states[-1][0] - recording.states[0][0]
         print(f"  drive: {simulated:.1f} s simulated in {wall:.1f} s wall, world {args.world}")

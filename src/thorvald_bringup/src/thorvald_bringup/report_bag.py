@@ -2,17 +2,21 @@
 
 Topics are found by their ending, so a robot in any namespace works: ``.../odometry/gazebo``,
 ``.../odometry/base_raw``, ``.../base_state``, and the commands ``.../twist_mux/cmd_vel`` (what
-base_driver got) or else ``.../nav_vel`` (what was sent). Messages are decoded with the definitions
-stored in the bag, so a bag from another machine reads without its message packages.
+base_driver got) or else ``.../nav_vel`` (what was sent); and, when recorded, RTK-GNSS
+``.../gps/fix`` with the IMU's ``.../imu/data`` (the antenna over base_link, the reference heading
+0). Messages are decoded with the definitions stored in the bag, so a bag from another machine
+reads without its message packages.
 """
 
 import rosbag
 
 from thorvald_base.conversions import quaternion_yaw
 
-from .odometry_report import Path, Recording, ReportError
+from .odometry_report import Path, Recording, ReportError, gnss_path
 
 ENDINGS = {
+    "fix": "gps/fix",
+    "imu": "imu/data",
     "truth": "odometry/gazebo",
     "odometry": "odometry/base_raw",
     "states": "base_state",
@@ -48,8 +52,15 @@ def read_recording(path: str, robot: str = "") -> Recording:
         command_topic = topics.get("commands", topics.get("sent"))
         rec = Recording([], Path(), Path(), [], robot=robot, source=path)
         wanted = [topics["truth"], topics["odometry"], topics["states"], command_topic]
+        wanted += [topics[k] for k in ("fix", "imu") if k in topics]
+        fixes, yaws = [], []
         for topic, msg, stamp in bag.read_messages(topics=wanted):
-            if topic == command_topic:
+            if topic == topics.get("fix"):
+                if msg.status.status >= 0:  # a fix (STATUS_NO_FIX is -1)
+                    fixes.append((msg.header.stamp.to_sec(), msg.latitude, msg.longitude))
+            elif topic == topics.get("imu"):
+                yaws.append((msg.header.stamp.to_sec(), quaternion_yaw(msg.orientation)))
+            elif topic == command_topic:
                 rec.commands.append((stamp.to_sec(), msg.linear.x, msg.linear.y, msg.angular.z))
             elif topic == topics["states"]:
                 rec.states.append((msg.header.stamp.to_sec(), tuple(msg.steer_pos), tuple(msg.prop_speed)))
@@ -58,6 +69,7 @@ def read_recording(path: str, robot: str = "") -> Recording:
                 p, v = msg.pose.pose, msg.twist.twist
                 pose = (p.position.x, p.position.y, quaternion_yaw(p.orientation))
                 series.append(msg.header.stamp.to_sec(), pose, (v.linear.x, v.linear.y, v.angular.z))
+    rec.gnss = gnss_path(sorted(fixes), sorted(yaws))
     for series in (rec.truth, rec.odometry):
         _sort(series)
     rec.commands.sort()

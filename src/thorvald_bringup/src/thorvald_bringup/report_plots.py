@@ -1,6 +1,7 @@
 """Figures 8 and 9 of the paper from a Report, as PNG files (matplotlib's Agg: no display needed).
 
-Figure 8: the paths by ground truth and by each odometry estimator, start and end marked.
+Figure 8: the paths by ground truth, by RTK-GNSS (when recorded) and by each odometry estimator, start
+and end marked (the figures in the legend are against the simulator's true pose).
 Figure 9: vx, vy and wz over time: the command, base_driver's odometry (lsq) and ground truth.
 """
 
@@ -14,16 +15,17 @@ STYLES = {
     "odometry lsq": {"color": "tab:blue", "linewidth": 1.2},
     "odometry paper": {"color": "tab:orange", "linewidth": 1.0, "linestyle": "--"},
     "command": {"color": "tab:green", "linewidth": 1.0, "linestyle": ":"},
+    "RTK-GNSS": {"color": "tab:gray", "linewidth": 0.8, "marker": ".", "markersize": 1.5},
 }
 
 
 def figure8(report, path: str) -> str:
     fig, ax = plt.subplots(figsize=(7, 7), dpi=100)
     for name, p in report.paths.items():
-        fig_ = report.figures[name]
+        fig_ = report.figures.get(name)
         label = (
             name
-            if name == "ground truth"
+            if fig_ is None or name == "ground truth"
             else f"{name} ({fig_.distance_error:+.2f} %, end {fig_.end_point_difference:.2f} m)"
         )
         ax.plot(p.x, p.y, label=label, **STYLES.get(name, {}))

@@ -13,6 +13,8 @@ from thorvald_bringup.odometry_report import (
     ReportError,
     aligned,
     format_report,
+    gnss_local,
+    gnss_path,
     make_report,
     path_length,
 )
@@ -151,3 +153,84 @@ def test_a_drive_short_of_its_plan_is_flagged(asym):
     assert "WARNING" not in format_report(report)
     report.planned_distance = 10.4
     assert "WARNING: ground truth drove only 96% of it" in format_report(report)
+
+
+# ---- RTK-GNSS and the IMU's yaw, as the paper measured ------------------------------------------
+LAT0, LON0 = 59.6646, 10.7635  # odometry_report_sensors.xacro's reference
+
+
+def hector_fix(x, y, heading=0.0):
+    """hector_gazebo_plugins' GNSS of a world point (x, y) [m]: its formulas, written out here."""
+    from thorvald_bringup.odometry_report import WGS84_A, WGS84_E2  # noqa: PLC0415
+
+    lat = math.radians(LAT0)
+    temp = 1.0 / (1.0 - WGS84_E2 * math.sin(lat) ** 2)
+    prime = WGS84_A * math.sqrt(temp)
+    r_north, r_east = prime * (1.0 - WGS84_E2) * temp, prime * math.cos(lat)
+    h = math.radians(heading)
+    latitude = LAT0 + (math.cos(h) * x + math.sin(h) * y) / r_north * 180.0 / math.pi
+    longitude = LON0 - (-math.sin(h) * x + math.cos(h) * y) / r_east * 180.0 / math.pi
+    return latitude, longitude
+
+
+def with_gnss(rec, noise=0.0, seed=1, rate=10.0):
+    """The recording with RTK-GNSS fixes of its ground truth at rate [Hz] with noise [m] per axis, and
+    the IMU's yaw at 100 Hz."""
+    import random  # noqa: PLC0415
+
+    rng = random.Random(seed)
+    fixes, yaws, next_fix = [], [], rec.truth.t[0]
+    for t, x, y, yaw in zip(rec.truth.t, rec.truth.x, rec.truth.y, rec.truth.yaw):
+        yaws.append((t, yaw))
+        if t >= next_fix - 1e-9:
+            fixes.append((t, *hector_fix(x + rng.gauss(0.0, noise), y + rng.gauss(0.0, noise))))
+            next_fix += 1.0 / rate
+    rec.gnss = gnss_path(fixes, yaws)
+    return rec
+
+
+def test_gnss_fixes_map_back_to_the_world_as_hector_made_them():
+    for x, y, heading in ((0.0, 0.0, 0.0), (12.5, -3.0, 0.0), (-40.0, 25.0, 30.0), (3.0, 4.0, -90.0)):
+        lat, lon = hector_fix(x, y, heading)
+        assert gnss_local(lat, lon, LAT0, LON0, heading) == pytest.approx((x, y), abs=1e-6)
+    # heading 0: hector's x is north, y west
+    assert hector_fix(100.0, 0.0)[0] > LAT0 and hector_fix(0.0, 100.0)[1] < LON0
+
+
+def test_odometry_against_rtk_gnss_as_the_paper_measured(asym):
+    rec = with_gnss(synthetic(asym, SQUARE_AND_CIRCLE, wheel_scale=1.02, truth_origin=(4.0, -2.0, 0.7)), noise=0.0)
+    report = make_report(rec, calculators(asym))
+    g = report.figures_gnss
+    # noise-free fixes at 10 Hz, averaged over 0.5 s and measured between points 0.1 m apart: ground
+    # truth's 20 m less what the averaging cuts at two right-angled corners driven at 1 m/s without
+    # slowing (from 0.2 m before to 0.2 m after: 0.4 - 0.2 sqrt 2 = 0.12 m each; a real drive slows
+    # down at corners) and on the circle (5 points 0.1 m apart on r 1.59 m: 0.4 % of 10 m)
+    assert 20.0 - 0.4 < g["RTK-GNSS"].distance < 20.0  # and the spacing: at most 0.04 m a corner
+    # every path is measured the same way, so the distance error is odometry's: +2 % (wheels 2 % large)
+    assert g["odometry lsq"].distance_error == pytest.approx(2.0, abs=0.05)
+    assert g["odometry lsq"].distance_error == pytest.approx(report.figures["odometry lsq"].distance_error, abs=0.25)
+    assert g["odometry lsq"].end_point_difference == pytest.approx(
+        report.figures["odometry lsq"].end_point_difference, abs=0.01
+    )
+    assert g["ground truth"].end_point_difference < 0.01  # ground truth and RTK-GNSS agree
+    text = format_report(report)
+    assert "against RTK-GNSS" in text and "RTK-GNSS" in text.splitlines()[-6]
+
+
+def test_rtk_noise_does_not_inflate_the_gnss_distance(asym):
+    rec = with_gnss(synthetic(asym, [(Twist(1.0, 0.0, 0.0), 20.0)]), noise=0.02)
+    report = make_report(rec, calculators(asym))
+    # 2 cm per axis at 10 Hz would add ~4 % between consecutive fixes; averaged over 5, +0.16 %; the
+    # seconds of standing still at each end add nothing: ground truth measured the same way reads
+    # what RTK-GNSS reads within 0.3 %
+    g = report.figures_gnss
+    assert abs(g["ground truth"].distance_error) < 0.3
+    assert g["RTK-GNSS"].distance == pytest.approx(20.0, abs=0.15)  # the start's average: 0.1 m
+    assert path_length(report.paths["RTK-GNSS"]) > 20.4  # what consecutive fixes would have read
+    assert report.figures_gnss["odometry lsq"].end_point_difference < 0.08  # 2 cm noise, both ends
+
+
+def test_a_recording_without_gnss_reports_ground_truth_only(asym):
+    report = make_report(synthetic(asym, SQUARE_AND_CIRCLE), calculators(asym))
+    assert report.figures_gnss == {} and "RTK-GNSS" not in report.paths
+    assert "RTK-GNSS" not in format_report(report).split("(the paper's column")[0]

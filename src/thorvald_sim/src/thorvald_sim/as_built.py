@@ -285,6 +285,23 @@ def for_simulator(as_built: AsBuilt, config: RobotConfig) -> SimAsBuilt:
     return SimAsBuilt(as_built.source, tuple(drives), as_built.delay, as_built.mass_offset)
 
 
+def describe_as_built(built: AsBuilt) -> str:
+    """One line for reports: each drive's radius against the configured one [%] and its steering
+    offset [deg], the encoders, the delay and the load."""
+    drives = []
+    for d, radius in zip(built.drives, built.configured):
+        text = f"{d.name} r {(d.r_wheel / radius - 1.0) * 100:+.2f} %"
+        if d.steering_offset:
+            text += f" steering {math.degrees(d.steering_offset):+.2f} deg"
+        drives.append(text)
+    extras = ["encoders counting" if built.encoders else "exact encoders"]
+    if built.delay:
+        extras.append(f"delay {built.delay * 1000:g} ms")
+    if built.mass_offset:
+        extras.append(f"load {built.mass_offset:g} kg")
+    return ", ".join(drives + extras)
+
+
 def _name(index: int) -> str:
     return f"drive{index}"
 
@@ -324,6 +341,7 @@ __all__ = [
     "SimAsBuilt",
     "as_built_for",
     "as_configured",
+    "describe_as_built",
     "draw_as_built",
     "for_simulator",
     "load_as_built",
