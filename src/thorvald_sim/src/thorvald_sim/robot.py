@@ -128,11 +128,13 @@ class SimRobot:
     # ---- set-up ---------------------------------------------------------------------------
     def _setup_joints(self) -> None:
         c, body, d = self.client, self.body, self.description
+        # pybullet gives every body a velocity damping of 0.04 /s, a drag no robot has. Damping belongs
+        # to the multibody (its base): on a link, changeDynamics with linearDamping/angularDamping
+        # silently drops the call's other settings, which left the wheels' friction at 0.5 (every
+        # world's grip under a wheel halved) until the two were set apart
+        p.changeDynamics(body, -1, linearDamping=0.0, angularDamping=0.0, physicsClientId=c)
         for link in range(-1, p.getNumJoints(body, physicsClientId=c)):
-            # pybullet gives every body a velocity damping of 0.04 /s, a drag no robot has
-            p.changeDynamics(
-                body, link, lateralFriction=LINK_FRICTION, linearDamping=0.0, angularDamping=0.0, physicsClientId=c
-            )
+            p.changeDynamics(body, link, lateralFriction=LINK_FRICTION, physicsClientId=c)
         self.steering = []  # (joint index, effort, velocity limit) per drive; None for type 1
         self.wheels = []  # (joint index, effort, radius) per drive
         self.accelerations = [drive.max_acceleration for drive in d.drives]  # [m/s^2]

@@ -3,10 +3,13 @@
 The caller passes in the client id; nothing here connects to pybullet or talks to ROS. Every body
 but an object with a mass is static (mass 0), so the world costs the solver nothing but its contacts:
 
-- the ground: a plane at z = 0, or the height field's grid in its place;
+- the ground: a plane at z = 0, or the height field's grid in its place; in a world with soft
+  patches, flat convex pieces 0.1 m thick with a hole under each patch (bullet's plane has none),
+  static bodies of up to 16 pieces, the first drawn as the plane;
 - a patch: a box 0.02 m thick whose top is 1 mm above the ground, so a wheel on the patch rests on
   the patch alone (bullet reports the ground 1 mm below too, but a contact that is not closing
-  carries no normal force, hence no friction);
+  carries no normal force, hence no friction); in a ground with holes, a box filling its hole, 0.3 m
+  deep for a soft patch, so a wheel sinking into it meets nothing else;
 - a hill: one convex trapezoidal prism (pybullet makes the convex hull of its 8 corners);
 - a rail: two cylinders along the rail's direction, their centres ``height`` above the ground;
 - an object: a pybullet box, cylinder or sphere, or the mesh file (a static mesh collides as its
@@ -25,15 +28,36 @@ Friction: pybullet multiplies the lateral frictions of the two bodies in a conta
 rolling and spinning friction as ``a.rolling * b.lateral + b.rolling * a.lateral`` and restitution
 as ``a * b``. The simulator's wheels have lateral friction 1.0 and no rolling or spinning friction,
 so the world's values are the effective ones under a wheel. (Restitution therefore matters only
-against bodies that have some of their own.)
+against bodies that have some of their own.) A soft surface gets pybullet's contact stiffness and
+damping (:attr:`Surface.contact_stiffness`): bullet turns them into the contact's ERP and CFM, an
+implicit spring and damper under each contact point, stable at any step; the wheels have none of
+their own (infinitely stiff in series).
 
-Visual colours (tarmac grey, gravel grey-brown, ice pale blue, earth, steel, leaf green) make
-snapshots show what is where; pybullet draws its checkered texture on the ground under the
-ground's colour (a height field gets checks of 1 m drawn for it, as the plane's).
+Checked (pybullet 3.2.7, 240 Hz; test_world_surfaces.py): a ball of 51 kg on mud (sinkage 15 mm)
+sinks 15 mm to 0.1 mm and then moves less than 5 um in 9 s; the standard robot's wheels rolling in
+mud sink their load over the stiffness to 0.1 % (11.4 to 14.7 mm for 380 to 490 N) and still roll
+0.2000 m a radian; standing there 10 s it stays within 0.1 mm of its height and creeps no more
+than its brakes let it on bullet's plane (about 0.5 mm in 10 s there). Every example robot drives
+through farm_track's gateway, in and out (the standard one 7 mm off its line and 0.7 mrad turned
+after 28 m). On a ground with holes, the rectangular pieces (boxes) are as bullet's plane to a robot
+and to a sliding box: the standard robot driving straight turns by less than 0.02 mrad in 12 s on
+both, the 2-wheel differential robot veers on its casters by the same 0.12 m in 6 m, and a box
+sliding across a seam stops where it does away from one. The pieces beside a turned patch are
+convex hulls, which are not: a box sliding across a seam between two hulls is thrown about (0.2 m
+boxes sliding at 2 m/s stopped from 23 % short to 56 % beyond where Coulomb friction stops them,
+one turned round), and the differential robot veered 0.41 m the other way in 6 m on hulls.
+Rolling friction costs bullet three more constraints a contact: a robot on the ``tarmac`` kind
+(0.003 m) steps a fifth slower than on this file's default ground (none).
+
+Visual colours (tarmac grey, gravel grey-brown, ice pale blue, a surface kind's own, earth, steel,
+leaf green) make snapshots show what is where; pybullet draws its checkered texture on the ground
+under the ground's colour (a height field gets checks of 1 m drawn for it, as the plane's).
 """
 
+import contextlib
 import math
 import os
+import sys
 import tempfile
 from dataclasses import dataclass
 from typing import Dict, Iterator, List, Optional, Sequence, Tuple
@@ -42,7 +66,11 @@ import numpy as np
 import pybullet as p
 
 from .world import (
+    GROUND_THICKNESS,
     PATCH_TOP,
+    RGBA_GRAVEL,
+    RGBA_ICE,
+    SOFT_DEPTH,
     TABLE_DEPTH,
     HeightField,
     Patch,
@@ -55,6 +83,7 @@ from .world import (
     Wall,
     WorldConfig,
     WorldObject,
+    ground_pieces,
     plant_positions,
 )
 
@@ -67,8 +96,6 @@ CONVEX_MARGIN = 0.001
 
 LOW_FRICTION = 0.3  # [-] below this a patch is drawn as ice rather than gravel
 
-RGBA_GRAVEL = (0.55, 0.48, 0.38, 1.0)
-RGBA_ICE = (0.70, 0.85, 1.00, 1.0)
 RGBA_HILL = (0.45, 0.50, 0.35, 1.0)
 RGBA_PIPE = (0.75, 0.75, 0.78, 1.0)
 RGBA_STEEL = (0.78, 0.80, 0.82, 1.0)  # galvanised tunnel hoops
@@ -82,6 +109,7 @@ TEXTURE_PIXELS_PER_CHECK = 4  # so the renderer's sampling keeps the checks' edg
 MAX_TEXTURE_PIXELS = 2048  # along a side of a height field's texture; a bigger field has bigger checks
 
 MAX_MESH_VERTICES = 65536  # per body; pybullet refuses a mesh of more than 131072
+MAX_SHAPES = 16  # pieces of a ground with holes in one body: pybullet's most shapes in one array
 ROOT = 0.1  # [m] plants, posts and legs reach this far into the ground, so a slope leaves no gap under them
 PRISM_SIDES = 8  # of a cylindrical plant
 STEM_SIDES = 4
@@ -104,7 +132,8 @@ class Scene:
     ``...table0``, ``...plants0`` and ``...berries0`` (drawn only, no collision), and
     ``"walls.wall0"``; in that order. A mesh of more than MAX_MESH_VERTICES goes on in bodies named
     ``.part1``, ``.part2``, ... after the first (``"rows.row0.1.part1"``); a row whose every place
-    is a gap has no body.
+    is a gap has no body. A ground with holes of more than MAX_SHAPES pieces goes on in bodies named
+    ``"ground.part1"``, ... (the first holds the pieces around the patches).
     """
 
     world: WorldConfig
@@ -114,13 +143,15 @@ class Scene:
 def build_scene(client: int, world: WorldConfig) -> Scene:
     """Sets gravity and adds every body of the world to the pybullet client; returns their ids."""
     p.setGravity(0, 0, -world.gravity, physicsClientId=client)
-    if world.height_field is None:
-        ground = _ground(client, world.ground, world.ground_rgba)
+    bodies: Dict[str, int] = {}
+    if world.height_field is None and world.soft_patches:
+        _add(bodies, "ground", _ground_with_holes(client, world))
+    elif world.height_field is None:
+        bodies["ground"] = _ground(client, world.ground, world.ground_rgba)
     else:
-        ground = _height_field(client, world.height_field, world.ground, world.ground_rgba)
-    bodies = {"ground": ground}
+        bodies["ground"] = _height_field(client, world.height_field, world.ground, world.ground_rgba)
     for patch in world.patches:
-        bodies[f"patches.{patch.name}"] = _patch(client, patch)
+        bodies[f"patches.{patch.name}"] = _patch(client, patch, holes=bool(world.soft_patches))
     for slope in world.slopes:
         bodies[f"slopes.{slope.name}"] = _slope(client, slope)
     for rail in world.rails:
@@ -153,6 +184,87 @@ def _ground(client: int, surface: Surface, rgba: Rgba) -> int:
     p.changeVisualShape(body, -1, rgbaColor=rgba, physicsClientId=client)
     _set_surface(client, body, surface)
     return body
+
+
+def _ground_with_holes(client: int, world: WorldConfig) -> List[int]:
+    """The ground with a hole under each patch: flat convex pieces (:func:`ground_pieces`, the four
+    around the patches first) in static bodies of at most MAX_SHAPES each, the first drawn as the
+    plane (its visual shape is a plane: pybullet draws it as its ground plane, checks and all), the
+    others not at all.
+
+    Rigid patches too fill holes of their own, so that nothing lies 1 mm under a patch for a box
+    sliding on it to catch its front edge on. A rectangular piece is a box (as the plane to what
+    moves on it, see the module's docstring), another a convex hull, from a file (pybullet makes
+    the vertices of one shape of an array into one hull only from a file). A hull grows by
+    CONVEX_MARGIN all round: its top is made that much lower, so that it ends at z = 0, and its
+    sides overlap its neighbours'.
+    """
+    pieces = ground_pieces([patch.corners() for patch in world.patches])
+    bodies = []
+    with tempfile.TemporaryDirectory() as folder:
+        for start in range(0, len(pieces), MAX_SHAPES):
+            types, halves, files, centres = [], [], [], []
+            for k, piece in enumerate(pieces[start : start + MAX_SHAPES], start):
+                xs, ys = [x for x, _ in piece], [y for _, y in piece]
+                if len(piece) == 4 and piece[0][1] == piece[1][1] and piece[2][1] == piece[3][1]:
+                    types.append(p.GEOM_BOX)
+                    halves.append(((max(xs) - min(xs)) / 2, (max(ys) - min(ys)) / 2, GROUND_THICKNESS / 2))
+                    files.append("")
+                    centres.append(((max(xs) + min(xs)) / 2, (max(ys) + min(ys)) / 2, -GROUND_THICKNESS / 2))
+                else:
+                    cx, cy = sum(xs) / len(xs), sum(ys) / len(ys)
+                    files.append(os.path.join(folder, f"piece{k}.obj"))
+                    outline = [(x - cx, y - cy) for x, y in piece]
+                    _write_prism(files[-1], outline, -CONVEX_MARGIN, CONVEX_MARGIN - GROUND_THICKNESS)
+                    types.append(p.GEOM_MESH)
+                    halves.append((0.0, 0.0, 0.0))
+                    centres.append((cx, cy, 0.0))
+            shape = p.createCollisionShapeArray(
+                types,
+                halfExtents=halves,
+                fileNames=files,
+                meshScales=[(1.0, 1.0, 1.0)] * len(types),
+                collisionFramePositions=centres,
+                physicsClientId=client,
+            )
+            if not bodies:
+                visual = p.createVisualShape(p.GEOM_PLANE, planeNormal=(0, 0, 1), physicsClientId=client)
+            else:  # a speck a metre underground: a body without a visual shape is drawn as its collision shapes
+                visual = p.createVisualShape(
+                    p.GEOM_SPHERE, radius=1e-4, visualFramePosition=(0, 0, -1), physicsClientId=client
+                )
+            with _quiet_stdout():  # pybullet's URDF importer warns that a plane has no default visual; it draws it
+                body = p.createMultiBody(0, shape, visual, physicsClientId=client)
+            if not bodies:
+                p.changeVisualShape(body, -1, rgbaColor=world.ground_rgba, physicsClientId=client)
+            _set_surface(client, body, world.ground)
+            bodies.append(body)
+    return bodies
+
+
+def _write_prism(path: str, corners: Sequence[Tuple[float, float]], top: float, bottom: float) -> None:
+    """An OBJ file of a prism over the polygon (counter-clockwise) from bottom to top [m]."""
+    n = len(corners)
+    lines = [f"v {x!r} {y!r} {bottom!r}" for x, y in corners] + [f"v {x!r} {y!r} {top!r}" for x, y in corners]
+    lines.append("f " + " ".join(str(n - i) for i in range(n)))  # the bottom, seen from below
+    lines.append("f " + " ".join(str(n + 1 + i) for i in range(n)))
+    lines += [f"f {i + 1} {(i + 1) % n + 1} {n + (i + 1) % n + 1} {n + i + 1}" for i in range(n)]
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """pybullet's C++ prints its warnings on file descriptor 1: silence it meanwhile."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
 
 
 def _height_field(client: int, field: HeightField, surface: Surface, rgba: Rgba) -> int:
@@ -197,16 +309,22 @@ def _checker_texture(client: int, size_x: float, size_y: float) -> int:
         return p.loadTexture(path, physicsClientId=client)
 
 
-def _patch(client: int, patch: Patch) -> int:
-    half = (patch.size_x / 2, patch.size_y / 2, PATCH_THICKNESS / 2)
-    color = RGBA_ICE if patch.surface.lateral_friction < LOW_FRICTION else RGBA_GRAVEL
+def _patch(client: int, patch: Patch, holes: bool) -> int:
+    # in a ground with holes a patch fills its own, a soft one deep enough that no wheel sinks through it
+    thickness = PATCH_THICKNESS
+    if patch.surface.soft:
+        thickness = PATCH_TOP + SOFT_DEPTH
+    elif holes:
+        thickness = PATCH_TOP + GROUND_THICKNESS
+    half = (patch.size_x / 2, patch.size_y / 2, thickness / 2)
+    color = patch.rgba or (RGBA_ICE if patch.surface.lateral_friction < LOW_FRICTION else RGBA_GRAVEL)
     shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
     visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=color, physicsClientId=client)
     body = p.createMultiBody(
         0,
         shape,
         visual,
-        basePosition=(patch.x, patch.y, PATCH_TOP - PATCH_THICKNESS / 2),
+        basePosition=(patch.x, patch.y, PATCH_TOP - thickness / 2),
         baseOrientation=p.getQuaternionFromEuler((0, 0, patch.yaw)),
         physicsClientId=client,
     )
@@ -619,6 +737,9 @@ def _polytunnel(client: int, t: Polytunnel, bodies: Dict[str, int]) -> None:
 
 
 def _set_surface(client: int, body: int, surface: Surface) -> None:
+    soft = {}
+    if surface.soft:
+        soft = dict(contactStiffness=surface.contact_stiffness, contactDamping=surface.contact_damping)
     p.changeDynamics(
         body,
         -1,
@@ -627,4 +748,5 @@ def _set_surface(client: int, body: int, surface: Surface) -> None:
         spinningFriction=surface.spinning_friction,
         restitution=surface.restitution,
         physicsClientId=client,
+        **soft,
     )

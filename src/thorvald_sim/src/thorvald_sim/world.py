@@ -2,22 +2,29 @@
 objects, crop rows, polytunnels, walls and uneven ground.
 
 The simulator node's ``~world`` parameter names a shipped world (``flat``, ``tarmac_gravel``,
-``slope``, ``greenhouse``, ``crop_rows``, ``polytunnel``, ``vineyard``: the files in this package's
-``worlds`` folder) or gives a path. A world file has these top-level keys (lengths [m], angles
-[rad], masses [kg]; frictions are pybullet's per-body coefficients, which pybullet multiplies with
-the wheel's; the simulator's wheels have friction 1.0). Defaults in brackets; a key without one is
-required. Every section's entries are numbered from 0 without gaps (``object0``, ``object1``, ...).
+``farm_track``, ``slope``, ``greenhouse``, ``crop_rows``, ``polytunnel``, ``vineyard``: the files in
+this package's ``worlds`` folder) or gives a path. A world file has these top-level keys (lengths
+[m], angles [rad], masses [kg]; frictions are pybullet's per-body coefficients, which pybullet
+multiplies with the wheel's; the simulator's wheels have friction 1.0). Defaults in brackets; a key
+without one is required. Every section's entries are numbered from 0 without gaps (``object0``, ``object1``, ...).
 A colour, ``rgba``, is a list of 3 or 4 numbers in [0, 1] (red, green, blue and alpha, 1 if left out).
 
 ``gravity``
     [m/s^2] (9.81).
 ``ground``
-    one mapping: ``lateral_friction`` (0.9), ``rolling_friction`` (0), ``spinning_friction`` (0),
-    ``restitution`` (0), ``rgba`` (tarmac grey ``[0.35, 0.35, 0.37, 1]``: the colour it is drawn in).
+    one mapping: ``surface`` (none: a kind of ground, below, whose numbers and colour are the
+    defaults of the keys that follow), ``lateral_friction`` (0.9), ``rolling_friction`` (0),
+    ``spinning_friction`` (0), ``sinkage`` (0: soft ground, below), ``restitution`` (0), ``rgba``
+    (tarmac grey ``[0.35, 0.35, 0.37, 1]``: the colour it is drawn in).
 ``patches``
-    ``patch0``, ...: rectangles of another friction lying on the ground (gravel, ice), centred at
-    ``x``, ``y``, ``size_x`` by ``size_y``, turned by ``yaw`` (0); ``lateral_friction``,
-    ``rolling_friction`` (0), ``spinning_friction`` (0).
+    ``patch0``, ...: rectangles of another surface lying on the ground (gravel, grass, mud, ice),
+    centred at ``x``, ``y``, ``size_x`` by ``size_y``, turned by ``yaw`` (0); ``surface`` (none),
+    ``lateral_friction`` (required without a surface), ``rolling_friction`` (0),
+    ``spinning_friction`` (0), ``sinkage`` (0), ``rgba`` (the surface's; gravel brown, or ice blue
+    below a lateral friction of 0.3, without one). A soft patch (``sinkage`` above 0) is let into
+    the ground: its top lies 1 mm above the ground as every patch's, and the ground has a hole under
+    it (and under every other patch then), so a wheel sinks into it (not with a ``height_field``,
+    which has no holes).
 ``slopes``
     ``slope0``, ...: hills along their own x axis: a ramp up at ``angle`` (at most 1.2), a flat top
     of ``top_length`` (0) at ``height``, a ramp down at ``angle``; ``x``, ``y`` is the centre of the
@@ -81,6 +88,62 @@ A colour, ``rgba``, is a list of 3 or 4 numbers in [0, 1] (red, green, blue and 
 ``description``
     free text.
 
+Surface kinds (``surface:`` on the ground and on patches; a key given beside it overrides its
+number). Numbers for the simulator's wheels (lateral friction 1.0, radius 0.2 m), from the
+published ranges for pneumatic and agricultural tyres:
+
+============  ========  =====  ===============  ========  ==========================================
+kind          lateral   C_rr   rolling_friction sinkage   what
+============  ========  =====  ===============  ========  ==========================================
+tarmac        0.9       0.015  0.003            0         dry asphalt
+concrete      0.85      0.012  0.0024           0         a dry concrete floor or yard
+gravel        0.6       0.05   0.01             0         loose gravel on a firm base
+grass         0.55      0.06   0.012            0.004     dry mown grass on firm soil
+wet_grass     0.3       0.08   0.016            0.008     wet grass, a field in the morning
+mud           0.35      0.2    0.04             0.015     wet, soft soil: a rutted gateway, a track
+sand          0.5       0.25   0.05             0.02      dry loose sand
+ice           0.1       0.01   0.002            0         ice, or wet plastic sheeting
+============  ========  =====  ===============  ========  ==========================================
+
+- ``lateral_friction`` is the tyre's peak grip, the friction coefficient of pybullet's Coulomb
+  cone in every direction, from the middle of the published ranges: dry asphalt and concrete 0.7
+  to 1.0 (tarmac 0.9 as this file's default ground, concrete a little smoother), loose gravel 0.5
+  to 0.7, dry grass 0.45 to 0.65, wet grass 0.2 to 0.4, wet clay and mud 0.2 to 0.5, dry sand 0.4
+  to 0.6, ice 0.05 to 0.15.
+- ``rolling_friction`` [m] is pybullet's rolling resistance: a torque against the wheel's turning of
+  this times the normal force, so it is the coefficient of rolling resistance C_rr times the wheel's
+  radius. C_rr (the middle of the published ranges: tyres on asphalt 0.01 to 0.02, on concrete
+  0.01 to 0.015, on gravel 0.02 to 0.08, on grass and firm field soil 0.05 to 0.1, on wet grass
+  about 0.08, in soft wet soil 0.1 to 0.3, in loose sand 0.15 to 0.3, on ice about 0.01) times the
+  Thorvald wheel's 0.2 m. A wheel of another radius r feels C_rr * 0.2 / r: a caster of 0.1 m
+  rolls twice as hard. It costs the drive motors torque (the motors hold their speed, so it shows
+  as odometry error only where it takes a motor to its torque limit); a coasting wheel slows. It
+  costs the simulator too: a robot on rolling friction steps about a fifth slower.
+- ``sinkage`` [m] is how far a rolling wheel carrying the reference load of 500 N (a 200 kg robot
+  on four wheels) sinks in: turf and topsoil give a few millimetres, wet grass twice that, mud and
+  sand 1 to 2 cm (the depth of the ruts a loaded wheel leaves); tarmac, concrete, ice, and gravel
+  on its firm base, none. The ground (or the patch) is a spring under each contact point that
+  bullet keeps: ``500 / sinkage`` [N/m], critically damped for the 51 kg that the reference load
+  weighs (damping ``2 * sqrt(stiffness * 51)`` [N s/m]: it settles within 0.2 s and does not
+  bounce at 240 Hz). So a wheel sinks in proportion to its load (the standard robot's wheels carry
+  380 to 490 N: 0.76 to 0.98 of ``sinkage``). A body resting on it shares its weight among its
+  points: a ball has one, a box four, and a wheel, a thin disc, one while it rolls; at rest bullet
+  often keeps a second point at the disc's other rim, and the wheel stands up to half its sinkage
+  higher until it rolls again. At most 0.05 m. What it does not do: pybullet applies friction at
+  the wheel's own rim, so a sunk wheel still rolls r * omega (measured: the standard robot's 0.2 m
+  wheels sunk 11 to 15 mm in mud travel 0.2000 m a radian): the ground truth and the sensors see
+  the robot lower and tilted, odometry sees no shorter rolling radius. Neither does any kind's
+  spinning friction: it is 0 for every kind (a steering motor turning a wheel on the spot is the
+  motor's business).
+
+The ground's own sinkage makes the whole ground plane soft (not a height field: bullet touches a
+wheel at one to four points of its triangles, rolling or not, so the sinkage would wander). A soft
+patch needs a hole in the ground: the ground of a world with soft patches is flat convex pieces
+0.1 m thick with a hole under every patch, each patch filling its own (the square of 2 km about the
+origin, :func:`ground_pieces`; beyond it there is no ground), drawn as the plane. Its rectangular
+pieces are as the plane to what drives or slides on them; the pieces beside a turned patch are not
+quite (see :mod:`thorvald_sim.scene`).
+
 Validation is the robot configuration's (:mod:`thorvald_model.schema`): every problem is collected
 with its dotted key path, value and rule, and raised together in one :class:`ConfigError`. Beyond
 each key's own rule: a rail's radius below its height and its gauge above two radii; an object has
@@ -89,7 +152,8 @@ at least its radius; a tunnel's height is above its leg height, its end gaps lea
 length, its tables leave aisles between them (``tables * table_width < width``) and its plants
 stay under its roof; a height field with an image takes no ``resolution``, one without takes no
 ``min_height`` or ``max_height``, its ``max_height`` is above its ``min_height`` and its
-``rut_width`` at most its ``rut_spacing``.
+``rut_width`` at most its ``rut_spacing``; a soft patch lies within 999 m of the origin in x and y;
+neither the ground nor a patch is soft in a world with a height field.
 
 Pure: no pybullet, no rospy, no messages (the scene is built by :mod:`thorvald_sim.scene`); the
 plants' positions, the tunnels' geometry and the heights of the ground are computed here, so tests
@@ -101,7 +165,7 @@ import glob
 import math
 import os
 import random
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 from thorvald_model.errors import MISSING, ConfigError, Problem
@@ -141,6 +205,17 @@ FLAT_BLEND = 1.0  # [m] over which a height field rises from its flat disc to fu
 MAX_PLANTS = 100_000  # per rows entry: a typing mistake in plant_spacing must not eat the memory
 MAX_FIELD_POINTS = 1_000_000  # of a height field's grid
 
+SINKAGE_LOAD = 500.0  # [N] on a wheel: the load a surface's sinkage is given for (a 200 kg robot on 4 wheels)
+SINKAGE_MASS = SINKAGE_LOAD / 9.81  # [kg] the reference load's mass, critically damped
+MAX_SINKAGE = 0.05  # [m]: deeper, a wheel is stuck, not sinking "a little"
+SOFT_DEPTH = 0.3  # [m] of a soft patch below its top: six times MAX_SINKAGE, so no wheel meets its bottom
+GROUND_THICKNESS = 0.1  # [m] of the pieces of a ground with holes
+GROUND_EXTENT = 1000.0  # [m] from the origin in x and y: a ground with holes ends there
+SOFT_PATCH_REACH = GROUND_EXTENT - 1.0  # [m]: a soft patch's corners within this of the origin in x and y
+
+RGBA_GRAVEL = (0.55, 0.48, 0.38, 1.0)
+RGBA_ICE = (0.70, 0.85, 1.00, 1.0)
+
 
 # ---------------------------------------------------------------------------------------------
 # Value types (SI units: m, rad, kg, m/s^2)
@@ -152,18 +227,68 @@ class Surface:
     pybullet multiplies the lateral frictions of the two bodies in a contact, and combines rolling
     and spinning friction as ``a.rolling * b.lateral + b.rolling * a.lateral`` and restitution as
     the product; the simulator's wheels have lateral friction 1.0 and no rolling or spinning
-    friction, so these are the effective values under a wheel.
+    friction, so these are the effective values under a wheel. A soft surface (``sinkage`` above 0)
+    is a spring and damper under each contact point (pybullet's contact stiffness and damping,
+    which it puts in series with the other body's: the wheels have none, so rigid).
     """
 
     lateral_friction: float  # [-] Coulomb coefficient
     rolling_friction: float  # [m] pybullet's rolling resistance (torque per normal force)
     spinning_friction: float  # [m] resistance to turning about the contact normal
     restitution: float = 0.0  # [-] 0 (no bounce) .. 1
+    sinkage: float = 0.0  # [m] of a contact point carrying SINKAGE_LOAD; 0 rigid
+    kind: str = field(default="", compare=False)  # the surface kind it was made from ("" for none)
+
+    @property
+    def soft(self) -> bool:
+        return self.sinkage > 0.0
+
+    @property
+    def contact_stiffness(self) -> float:
+        """[N/m] of each contact point: SINKAGE_LOAD sinks it by ``sinkage`` (infinite when rigid)."""
+        return SINKAGE_LOAD / self.sinkage if self.soft else math.inf
+
+    @property
+    def contact_damping(self) -> float:
+        """[N s/m] of each contact point: critical for SINKAGE_MASS on the spring (0 when rigid)."""
+        return 2.0 * math.sqrt(self.contact_stiffness * SINKAGE_MASS) if self.soft else 0.0
+
+
+@dataclass(frozen=True)
+class SurfaceKind:
+    """A named kind of ground (``surface: mud``): its numbers and colour (see the module's table)."""
+
+    lateral_friction: float  # [-]
+    rolling_resistance: float  # [-] C_rr, the rolling resistance coefficient
+    rolling_friction: float  # [m] C_rr times REFERENCE_WHEEL_RADIUS
+    sinkage: float  # [m] under SINKAGE_LOAD
+    rgba: Rgba
+    what: str
+
+    def surface(self, name: str) -> Surface:
+        return Surface(self.lateral_friction, self.rolling_friction, 0.0, 0.0, self.sinkage, name)
+
+
+REFERENCE_WHEEL_RADIUS = 0.2  # [m], Thorvald II's: rolling_friction = C_rr * this
+
+# The module's table; rolling_friction is written out (C_rr * 0.2, checked by a test) so that the
+# numbers are the table's to the last digit.
+SURFACE_KINDS: Dict[str, SurfaceKind] = {
+    "tarmac": SurfaceKind(0.9, 0.015, 0.003, 0.0, RGBA_TARMAC, "dry asphalt"),
+    "concrete": SurfaceKind(0.85, 0.012, 0.0024, 0.0, RGBA_CONCRETE, "a dry concrete floor or yard"),
+    "gravel": SurfaceKind(0.6, 0.05, 0.01, 0.0, RGBA_GRAVEL, "loose gravel on a firm base"),
+    "grass": SurfaceKind(0.55, 0.06, 0.012, 0.004, (0.33, 0.55, 0.22, 1.0), "dry mown grass on firm soil"),
+    "wet_grass": SurfaceKind(0.3, 0.08, 0.016, 0.008, (0.22, 0.45, 0.20, 1.0), "wet grass"),
+    "mud": SurfaceKind(0.35, 0.2, 0.04, 0.015, (0.38, 0.28, 0.18, 1.0), "wet, soft soil"),
+    "sand": SurfaceKind(0.5, 0.25, 0.05, 0.02, (0.82, 0.73, 0.52, 1.0), "dry loose sand"),
+    "ice": SurfaceKind(0.1, 0.01, 0.002, 0.0, RGBA_ICE, "ice, or wet plastic sheeting"),
+}
 
 
 @dataclass(frozen=True)
 class Patch:
-    """A rectangle of another friction lying on the ground (its top 1 mm above the ground)."""
+    """A rectangle of another surface lying on the ground (its top 1 mm above the ground); a soft
+    one is let into the ground (the ground has a hole under it)."""
 
     name: str
     index: int
@@ -173,11 +298,17 @@ class Patch:
     size_y: float  # [m]
     yaw: float  # [rad] of the patch's x axis from the world's
     surface: Surface
+    rgba: Optional[Rgba] = None  # the file's or its surface kind's; None: the scene's (gravel or ice)
 
     def contains(self, px: float, py: float) -> bool:
         """Whether the ground point (px, py) [m] lies on the patch (edges included)."""
         u, v = _to_local(px - self.x, py - self.y, self.yaw)
         return abs(u) <= self.size_x / 2 and abs(v) <= self.size_y / 2
+
+    def corners(self) -> Tuple[Point, Point, Point, Point]:
+        """[m] the four corners in the world, counter-clockwise from the patch's (-x, -y) corner."""
+        hx, hy = self.size_x / 2, self.size_y / 2
+        return tuple(_along(self.x, self.y, self.yaw, u, v) for u, v in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)))
 
 
 @dataclass(frozen=True)
@@ -511,8 +642,14 @@ class WorldConfig:
 
     def ground_height(self, px: float, py: float) -> float:
         """[m] of the ground's surface at (px, py): the height field (0 off it, or without one), the
-        hills and the patches' tops, whichever is highest (not rails, objects, plants or tunnels)."""
+        hills and the patches' tops, whichever is highest (not rails, objects, plants or tunnels).
+        A soft surface's top, before anything sinks into it."""
         return _ground_height(self.height_field, self.slopes, self.patches, px, py)
+
+    @property
+    def soft_patches(self) -> Tuple[Patch, ...]:
+        """The soft patches; with any, the ground has a hole under every patch."""
+        return tuple(pa for pa in self.patches if pa.surface.soft)
 
 
 def _ground_height(
@@ -526,6 +663,114 @@ def _ground_height(
     if any(patch.contains(px, py) for patch in patches):
         z = max(z, PATCH_TOP)
     return z
+
+
+def ground_pieces(holes: Sequence[Sequence[Point]], extent: float = GROUND_EXTENT) -> List[Tuple[Point, ...]]:
+    """Convex pieces (3 or 4 corners [m], counter-clockwise) that tile the square ``|x|, |y| <=
+    extent`` but for the holes (convex polygons, counter-clockwise, inside the square; they may
+    overlap).
+
+    Around the holes' bounding box, four pieces turned like a pinwheel (so their seams are four
+    rays from its corners); within it, a vertical-slab (trapezoidal) decomposition: the box is cut
+    at the x of every corner of a hole and of every crossing of two holes' edges. Within a slab no
+    edge ends or crosses another, so each hole is a band between two straight lines there, and the
+    ground between the bands (merged where they overlap) a trapezoid each, or a triangle where two
+    lines meet at the slab's side. Cuts closer than SNAP are one (a sliver under a tenth of a
+    millimetre wide is no ground a wheel can find), and a piece thinner than SNAP all along is left
+    out.
+    """
+    e = extent
+    if not holes:
+        return [((-e, -e), (e, -e), (e, e), (-e, e))]
+    x0, x1 = min(x for hole in holes for x, _ in hole), max(x for hole in holes for x, _ in hole)
+    y0, y1 = min(y for hole in holes for _, y in hole), max(y for hole in holes for _, y in hole)
+    outside = [
+        ((-e, -e), (x0, -e), (x0, y1), (-e, y1)),  # left, below the top
+        ((-e, y1), (x1, y1), (x1, e), (-e, e)),  # top, left of the right
+        ((x1, y0), (e, y0), (e, e), (x1, e)),  # right, above the bottom
+        ((x0, -e), (e, -e), (e, y0), (x0, y0)),  # bottom, right of the left
+    ]
+    pieces = [q for q in outside if q[1][0] - q[0][0] > SNAP and q[3][1] - q[0][1] > SNAP]
+    return pieces + _slab_pieces(holes, x0, x1, y0, y1)
+
+
+def _slab_pieces(
+    holes: Sequence[Sequence[Point]], x0: float, x1: float, y0: float, y1: float
+) -> List[Tuple[Point, ...]]:
+    """ground_pieces' trapezoids within the box from (x0, y0) to (x1, y1)."""
+    xs = {x0, x1}
+    edges = [_edges(hole) for hole in holes]
+    for hole in holes:
+        xs.update(x for x, _ in hole)
+    for i in range(len(edges)):
+        for j in range(i + 1, len(edges)):
+            for a in edges[i]:
+                for b in edges[j]:
+                    x = _crossing_x(a, b)
+                    if x is not None:
+                        xs.add(x)
+    cuts: List[float] = []
+    for x in sorted(xs):
+        if not cuts or x - cuts[-1] > SNAP:
+            cuts.append(x)
+    cuts[-1] = x1
+    pieces: List[Tuple[Point, ...]] = []
+    bottom, top = ((x0, y0), (x1, y0)), ((x0, y1), (x1, y1))
+    for xa, xb in zip(cuts, cuts[1:]):
+        xm = (xa + xb) / 2
+        bands = []
+        for hole_edges in edges:
+            crossing = [e for e in hole_edges if min(e[0][0], e[1][0]) < xm < max(e[0][0], e[1][0])]
+            if len(crossing) == 2:
+                low, high = sorted(crossing, key=lambda e: _line_y(e, xm))
+                bands.append([low, high])
+        bands.sort(key=lambda band: _line_y(band[0], xm))
+        merged: List[List[Tuple[Point, Point]]] = []
+        for band in bands:
+            if merged and _line_y(band[0], xm) <= _line_y(merged[-1][1], xm):
+                if _line_y(band[1], xm) > _line_y(merged[-1][1], xm):
+                    merged[-1][1] = band[1]
+            else:
+                merged.append(band)
+        lows = [bottom] + [band[1] for band in merged]
+        highs = [band[0] for band in merged] + [top]
+        for low, high in zip(lows, highs):
+            corners = [(xa, _line_y(low, xa)), (xb, _line_y(low, xb)), (xb, _line_y(high, xb)), (xa, _line_y(high, xa))]
+            if corners[2][1] - corners[1][1] <= SNAP and corners[3][1] - corners[0][1] <= SNAP:
+                continue
+            if corners[2][1] - corners[1][1] <= SNAP:
+                del corners[2]
+            elif corners[3][1] - corners[0][1] <= SNAP:
+                del corners[3]
+            pieces.append(tuple(corners))
+    return pieces
+
+
+SNAP = 1e-4  # [m]: ground_pieces' cuts closer than this are one
+
+
+def _edges(polygon: Sequence[Point]) -> List[Tuple[Point, Point]]:
+    return [(polygon[i], polygon[(i + 1) % len(polygon)]) for i in range(len(polygon))]
+
+
+def _line_y(edge: Tuple[Point, Point], x: float) -> float:
+    """y [m] of the edge's line at x (the edge is not vertical)."""
+    (x1, y1), (x2, y2) = edge
+    return y1 + (y2 - y1) * (x - x1) / (x2 - x1)
+
+
+def _crossing_x(a: Tuple[Point, Point], b: Tuple[Point, Point]) -> Optional[float]:
+    """x [m] where two edges cross each other inside both; None if they do not (or are parallel)."""
+    (x1, y1), (x2, y2) = a
+    (x3, y3), (x4, y4) = b
+    d = (x2 - x1) * (y4 - y3) - (y2 - y1) * (x4 - x3)
+    if abs(d) < 1e-12:
+        return None
+    t = ((x3 - x1) * (y4 - y3) - (y3 - y1) * (x4 - x3)) / d
+    u = ((x3 - x1) * (y2 - y1) - (y3 - y1) * (x2 - x1)) / d
+    if 0.0 < t < 1.0 and 0.0 < u < 1.0:
+        return x1 + t * (x2 - x1)
+    return None
 
 
 def _to_local(dx: float, dy: float, yaw: float) -> Tuple[float, float]:
@@ -646,7 +891,23 @@ def _frictions(lateral: float) -> Tuple[Key, ...]:
 UNIT_RANGE = dict(check=in_range(0.0, 1.0), rule="must be in [0, 1]")
 OPTIONAL_POSITIVE = dict(default=None, **POSITIVE)  # a key a cross-field rule requires or refuses
 
-GROUND_KEYS = (*_frictions(0.9), Key("restitution", float, 0.0, **UNIT_RANGE), RGBA_KEY)
+KINDS_RULE = "must be one of " + ", ".join(SURFACE_KINDS)
+SINKAGE_RULE = f"must be in [0, {MAX_SINKAGE}] [m]"
+
+# The ground's and the patches' surface keys default to None: a key not in the file takes its
+# surface kind's number (_surface_of), or else the default in SURFACE_DEFAULTS.
+SURFACE_KEYS = (
+    Key("surface", str, None, check=one_of(*SURFACE_KINDS), rule=KINDS_RULE),
+    Key("lateral_friction", float, None, **NON_NEGATIVE),
+    Key("rolling_friction", float, None, **NON_NEGATIVE),
+    Key("spinning_friction", float, None, **NON_NEGATIVE),
+    Key("sinkage", float, None, check=in_range(0.0, MAX_SINKAGE), rule=SINKAGE_RULE),
+)
+SURFACE_DEFAULTS = {"rolling_friction": 0.0, "spinning_friction": 0.0, "sinkage": 0.0}
+ZERO_HINT = "write sinkage: 0 beside a soft surface kind"
+
+GROUND_KEYS = (*SURFACE_KEYS, Key("restitution", float, 0.0, **UNIT_RANGE), RGBA_KEY)
+GROUND_DEFAULTS = {**SURFACE_DEFAULTS, "lateral_friction": 0.9}
 
 PATCH_KEYS = (
     Key("x", float),
@@ -654,9 +915,8 @@ PATCH_KEYS = (
     Key("size_x", float, **POSITIVE),
     Key("size_y", float, **POSITIVE),
     Key("yaw", float, 0.0),
-    Key("lateral_friction", float, **NON_NEGATIVE),
-    Key("rolling_friction", float, 0.0, **NON_NEGATIVE),
-    Key("spinning_friction", float, 0.0, **NON_NEGATIVE),
+    *SURFACE_KEYS,
+    RGBA_KEY,
 )
 
 MAX_SLOPE_ANGLE = 1.2  # [rad], about 69 degrees: steeper is a wall, and tan() grows without bound
@@ -828,11 +1088,13 @@ def parse_world(data: Any, source: str = "<world>", base_dir: Optional[str] = No
 
     # A missing ground, or an empty ``ground:`` (YAML null), means every default, as for sections.
     raw_ground = data.get("ground")
-    raw_ground, ground_colour = _take_colour({} if raw_ground is None else raw_ground, "ground", RGBA_TARMAC, problems)
+    raw_ground = {} if raw_ground is None else raw_ground
+    raw_ground, ground_colour = _take_colour(raw_ground, "ground", None, problems)
     ground_values = parse_entry(raw_ground, "ground", GROUND_KEYS, problems)
     if ground_values is None:
         ground_values = {k.name: k.default for k in GROUND_KEYS}
-    ground = _surface(ground_values)
+    ground = _surface_of(ground_values, GROUND_DEFAULTS)
+    ground_colour = ground_colour or _kind_colour(ground) or RGBA_TARMAC
 
     height_field = None
     if data.get("height_field") is not None:
@@ -849,7 +1111,12 @@ def parse_world(data: Any, source: str = "<world>", base_dir: Optional[str] = No
             if RGBA_KEY in keys:
                 values["rgba"] = colours.get(name)
 
+    problems.extend(_missing_lateral_friction(data.get("patches")))
     patches = tuple(_patch(name, index, v) for name, index, v, _ in entries["patches"])
+    problems.extend(_soft_patch_problems(patches, height_field is not None))
+    if height_field is not None and ground.soft:
+        rule = f"must be 0 with a height_field ({ZERO_HINT}): bullet touches a wheel at 1 to 4 of its triangles"
+        problems.append(Problem("ground.sinkage", ground.sinkage, rule))
     slopes = tuple(_slope(name, index, v) for name, index, v, _ in entries["slopes"])
     rails = tuple(_rail(name, index, v) for name, index, v, _ in entries["rails"])
     problems.extend(_rail_problems(rails, problems))
@@ -933,8 +1200,65 @@ def _surface(values: Mapping) -> Surface:
     )
 
 
+def _surface_of(v: Mapping, defaults: Mapping) -> Surface:
+    """The surface of an entry with SURFACE_KEYS: each number the file's, else its kind's, else the
+    default (0 for a key missing from defaults: :func:`_missing_lateral_friction` reports it)."""
+    kind = SURFACE_KINDS.get(v["surface"])
+    base = kind.surface(v["surface"]) if kind else None
+    numbers = {}
+    for name in ("lateral_friction", "rolling_friction", "spinning_friction", "sinkage"):
+        if v[name] is not None:
+            numbers[name] = v[name]
+        elif base is not None:
+            numbers[name] = getattr(base, name)
+        else:
+            numbers[name] = defaults.get(name, 0.0)
+    return Surface(
+        numbers["lateral_friction"],
+        numbers["rolling_friction"],
+        numbers["spinning_friction"],
+        v.get("restitution", 0.0),
+        numbers["sinkage"],
+        v["surface"] or "",
+    )
+
+
+def _kind_colour(surface: Surface) -> Optional[Rgba]:
+    kind = SURFACE_KINDS.get(surface.kind)
+    return kind.rgba if kind else None
+
+
 def _patch(name: str, index: int, v: Mapping) -> Patch:
-    return Patch(name, index, v["x"], v["y"], v["size_x"], v["size_y"], v["yaw"], _surface(v))
+    surface = _surface_of(v, SURFACE_DEFAULTS)
+    colour = v["rgba"] or _kind_colour(surface)
+    return Patch(name, index, v["x"], v["y"], v["size_x"], v["size_y"], v["yaw"], surface, colour)
+
+
+def _missing_lateral_friction(section: Any) -> List[Problem]:
+    """A patch's lateral friction is required unless it names a surface kind (reported as parse_entry
+    reports a required key: beside the entry's other problems, even when they drop the entry)."""
+    if not isinstance(section, Mapping):
+        return []
+    return [
+        Problem(f"patches.{name}.lateral_friction", MISSING, "is required")
+        for name, entry in section.items()
+        if isinstance(entry, Mapping) and "lateral_friction" not in entry and "surface" not in entry
+    ]
+
+
+def _soft_patch_problems(patches: Sequence[Patch], height_field: bool) -> List[Problem]:
+    problems = []
+    for patch in patches:
+        if not patch.surface.soft:
+            continue
+        path = f"patches.{patch.name}.sinkage"
+        if height_field:
+            rule = f"must be 0 with a height_field ({ZERO_HINT}): a soft patch needs a hole in the ground"
+            problems.append(Problem(path, patch.surface.sinkage, rule))
+        elif max(max(abs(x), abs(y)) for x, y in patch.corners()) > SOFT_PATCH_REACH:
+            rule = f"needs the patch within {SOFT_PATCH_REACH:g} m of the origin in x and y (the ground ends there)"
+            problems.append(Problem(path, patch.surface.sinkage, rule))
+    return problems
 
 
 def _slope(name: str, index: int, v: Mapping) -> Slope:

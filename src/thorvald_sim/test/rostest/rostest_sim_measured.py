@@ -4,6 +4,7 @@
 On tarmac, 10 m at 1 m/s: odometry's distance within 2 % of ground truth's. On ice (friction 0.1)
 the robot starts from rest at 1 m/s: its wheels ramp up at their controllers' 1.5 m/s^2, the robot
 can accelerate at mu g = 0.98 m/s^2 at most, so ground truth falls behind odometry: the slip is real.
+(Until the wheels' friction was really 1.0, they had 0.5 and the ice 0.05: about 0.5 m against 1 m.)
 """
 
 import unittest
@@ -61,11 +62,11 @@ class SimMeasuredTest(unittest.TestCase):
         rospy.loginfo("ice: ground truth %.4f m, odometry %.4f m", truth[0], odom[0])
         # odometry counts the wheels' turns: 1 m/s reached at 1.5 m/s^2 after 0.67 s, 1.17 m in 1.5 s
         # (less the command's way through twist_mux and base_driver's cycle); the robot accelerates at
-        # most mu g = 0.98 m/s^2: at most 0.98 * 1.5^2 / 2 = 1.10 m, and much less while its wheels
-        # spin (about 0.5 m here against about 1 m of odometry)
+        # most mu g = 0.98 m/s^2, reaching 1 m/s after 1.02 s: at most 0.51 + 0.48 = 0.99 m in 1.5 s,
+        # 0.18 m behind its wheels (0.94 m against 1.13 m of odometry here)
         self.assertGreater(odom[0], 0.5)  # it drove
-        self.assertLess(truth[0], 1.10)
-        self.assertLess(truth[0], 0.75 * odom[0])
+        self.assertLess(truth[0], 0.99)
+        self.assertGreater(odom[0] - truth[0], 0.1)
 
 
 if __name__ == "__main__":
