@@ -10,6 +10,10 @@ Private parameters besides the configuration:
 =================================  ===========================================================
 ``~robot_model``                   path of the YAML: read when the namespace holds no
                                    configuration, and named in configuration errors
+``~calibration``                   path of a calibration file (``calibrate_odometry`` writes it:
+                                   ``motor_drives: {driveN: {r_wheel: X, steering_offset: Y}}``),
+                                   applied at start through set_drive_params and checked as the
+                                   robot file is; default empty: none
 ``~simple_sim``                    simulate the drives (true) or drive the real base over CAN
 ``~base_handle``                   the base handle (thorvald_base.bases): default
                                    ``simple_sim`` with simple_sim true, else ``can``
@@ -26,15 +30,22 @@ Private parameters besides the configuration:
 ``~projection``                    unrealisable twists on a fixed axle: ``axle`` (default) or ``lsq``
 ``~measured_timeout``              with ``base_handle: simulated_joints``: drive states older than
                                    this stop the wheels [s] (default 0.5)
+``~lockstep``                      with ``base_handle: simulated_joints`` and the simulator's
+                                   ``~lockstep``: the loop runs on the arrival of drive states
+                                   instead of the clock, a cycle at the first instant ~rate asks
+                                   for, and answers every other instant with the last commands, so
+                                   the simulator steps only when base_driver has (default false)
 ``~can_interface_type/name``       the CAN line of a real base: a python-can interface
                                    (``socketcan``, ``slcan``, ``virtual``, ``pcan``, ...) and channel
 ``~can_bitrate``                   for interfaces that set it (default 1000000)
 ``~allow_relay_to_base_devices``   relay frames addressed to the base's own devices (default false)
 =================================  ===========================================================
 
-A bad configuration or parameter stops the node at start with a fatal log naming it, exit status 1.
+A bad configuration, calibration file or parameter stops the node at start with a fatal log naming
+it (the file, the key path, the value and the rule), exit status 1.
 """
 
+import math
 import sys
 import threading
 
@@ -60,6 +71,7 @@ from thorvald_msgs.srv import (
 from . import conversions
 from .bases import create_base_handle
 from .bases.handle import DriveTopics, Ports
+from .calibration import load_calibration
 from .core import BaseDriverCore, PoseCovariance
 from .diagnostics import LinkWatch, base_statuses
 from .errors import ParameterError, ThorvaldBaseError
@@ -129,14 +141,23 @@ class BaseDriverNode:
         self.base_frame = params.base_frame
         self.enable_tf = params.enable_odom_tf
         self.rate = params.rate
+        self.lockstep = params.lockstep
+        if self.lockstep and params.handle != "simulated_joints":
+            raise ParameterError(
+                f"~lockstep: true needs ~base_handle simulated_joints (the simulator's drives), not {params.handle}"
+            )
         self.covariance = PoseCovariance(params.twist_covariance)
         calculator = load_calculator(self.config, estimator=params.estimator, projection=params.projection)
         handle = create_base_handle(self.config, params, RosPorts())
         try:
             self.core = BaseDriverCore(self.config, calculator, handle, command_timeout=params.command_timeout)
-        except ThorvaldBaseError:
+            if params.calibration:
+                self.apply_calibration(params.calibration)
+        except (ConfigError, ThorvaldBaseError):
             handle.close()
             raise
+        # the calibrated configuration is what it drives (set_drive_params may change it later: core.config)
+        self.config = self.core.config
         if from_file:
             for key, value in self.config.to_dict().items():
                 rospy.set_param("~" + key, value)
@@ -190,6 +211,19 @@ class BaseDriverNode:
             params.handle,
             self.rate,
             "on" if self.enable_tf else "off",
+        )
+
+    def apply_calibration(self, path):
+        """The calibration file's values, checked against the robot and applied as set_drive_params
+        applies them (the handle built on the robot file keeps its spawn radii: simulated_joints)."""
+        changes = load_calibration(path, self.core.config)
+        _, problems = self.core.set_drive_params(changes)
+        if problems:
+            raise ParameterError(f"~calibration: {path}: " + "; ".join(problems))
+        rospy.loginfo(
+            "base_driver: calibration %s: %s",
+            path,
+            ", ".join(f"drive{i} {key} {value:g}" for i, key, value in changes) or "nothing to change",
         )
 
     # ---- callbacks: message -> core -> message -----------------------------------------------
@@ -271,6 +305,8 @@ class BaseDriverNode:
 
     # ---- the loop ----------------------------------------------------------------------------
     def spin(self):
+        if self.lockstep:
+            return self.spin_lockstep()
         rate = rospy.Rate(self.rate)
         last = None
         while not rospy.is_shutdown():
@@ -303,6 +339,36 @@ class BaseDriverNode:
                 rospy.logwarn("base_driver: time moved backwards; odometry integration restarts")
             except rospy.ROSInterruptException:
                 break
+
+    def spin_lockstep(self):
+        """The loop in lockstep with the simulator: each arrival of drive states at instant t is either
+        a cycle or answered with the last commands. The cycles are the first instants at or after
+        each multiple of 1 / ~rate of simulated time, the same whenever base_driver started, so two
+        runs (and two robots) cycle at the same instants; what a cycle sees is the states of its
+        instant, never an older or a newer one."""
+        handle = self.core.handle
+        period = 1.0 / self.rate
+        last, next_cycle = None, -math.inf
+        while not rospy.is_shutdown():
+            t = handle.wait_for_states(last, 0.2)
+            if t is None:
+                continue
+            last = t
+            if t >= next_cycle - 1e-9:
+                next_cycle = (math.floor(t / period + 1e-9) + 1) * period
+                stamp = rospy.Time.from_sec(t)
+                with self.lock:
+                    if self.core.closed:
+                        break
+                    result = self.core.step(t)
+                    if result.odometry.valid:
+                        self.covariance.update(result.odometry)
+                self.publish(result, stamp)
+            else:
+                with self.lock:
+                    if self.core.closed:
+                        break
+                    handle.answer(t)
 
     def publish(self, result, stamp):
         # core.config, not self.config: set_drive_params may have changed r_wheel since start-up

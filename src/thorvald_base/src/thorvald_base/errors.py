@@ -43,3 +43,8 @@ class PluginDescriptionError(PluginError):
 
 class ParameterError(ThorvaldBaseError):
     """A node's ROS parameter is missing or invalid; the message names the parameter, value and rule."""
+
+
+class CalibrationError(ThorvaldBaseError):
+    """A recorded drive cannot calibrate odometry (too little of it, no ground truth, or it excites
+    no parameter); the message says which and why."""

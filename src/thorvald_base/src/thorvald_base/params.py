@@ -24,6 +24,7 @@ class DriverParams:
     """base_driver's private parameters besides the robot configuration (units in brackets)."""
 
     robot_model: str = ""  # the robot's YAML: read when the namespace holds no configuration
+    calibration: str = ""  # a calibration file (calibrate_odometry's) applied at start through set_drive_params
     simple_sim: bool = False  # simulate the drives (true) or drive the real base
     base_handle: str = ""  # thorvald_base.bases name; empty: simple_sim, or can without simple_sim
     tf_prefix: str = ""  # normalised: "" or "robot_1/" (from "robot_1/" or the older "robot_1")
@@ -36,6 +37,7 @@ class DriverParams:
     estimator: str = "lsq"
     projection: str = "axle"
     measured_timeout: float = 0.5  # simulated_joints: drive states older than this stop the wheels [s]
+    lockstep: bool = False  # simulated_joints: a cycle per arrival of drive states, each answered (the simulator's)
     can_interface_type: str = ""  # python-can interface (socketcan, slcan, virtual, pcan, ...)
     can_interface_name: str = ""  # its channel
     can_bitrate: int = DEFAULT_BITRATE  # [bit/s], for interfaces that set it
@@ -60,6 +62,7 @@ class DriverParams:
                 **values,
                 "tf_prefix": normalize_tf_prefix(values.get("tf_prefix", "")),
                 "robot_model": str(values.get("robot_model", "") or ""),
+                "calibration": str(values.get("calibration", "") or ""),
                 "base_handle": str(values.get("base_handle", "") or ""),
                 "odom_frame_id": str(values.get("odom_frame_id", "odom")),
                 "can_interface_type": str(values.get("can_interface_type", "") or ""),
@@ -69,6 +72,7 @@ class DriverParams:
                 "enable_odom_tf": _flag(values, "enable_odom_tf", True),
                 "passthrough_gazebo_odometry": _flag(values, "passthrough_gazebo_odometry", False),
                 "allow_relay_to_base_devices": _flag(values, "allow_relay_to_base_devices", False),
+                "lockstep": _flag(values, "lockstep", False),
                 "rate": _positive(values, "rate", 50.0, "Hz"),
                 "command_timeout": _number(values, "command_timeout", 0.5),  # BaseDriverCore checks > 0
                 "measured_timeout": _positive(values, "measured_timeout", 0.5, "s"),

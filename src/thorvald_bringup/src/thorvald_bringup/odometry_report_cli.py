@@ -12,6 +12,8 @@ states), next to the paper's figures; Figures 8 and 9 are written as PNG.
 """
 
 import argparse
+import json
+import math
 import os
 import shutil
 import subprocess
@@ -55,6 +57,13 @@ def parser() -> argparse.ArgumentParser:
         default="odometry_report",
         help="where the bag and the figures go (default ./odometry_report)",
     )
+    p.add_argument(
+        "--calibration",
+        metavar="FILE",
+        default="",
+        help="base_driver's calibration file (rosrun thorvald_base calibrate_odometry writes it)",
+    )
+    p.add_argument("--json", metavar="FILE", help="also write the figures as JSON to FILE")
     p.add_argument("--real-time-factor", type=float, default=0.0, help="0: as fast as the machine can (default)")
     p.add_argument("--gui", action="store_true", help="open pybullet's window")
     p.add_argument("--timeout", type=float, default=600.0, help="wall seconds the drive may take (default 600)")
@@ -92,6 +101,7 @@ def drive(args, model: str, bag: str) -> float:
         f"real_time_factor:={args.real_time_factor:g}",
         f"with_gui:={'true' if args.gui else 'false'}",
         f"as_built:={args.as_built}",
+        f"calibration:={os.path.abspath(args.calibration) if args.calibration else ''}",
     ]
     for stale in (bag, bag + ".active"):
         if os.path.exists(stale):
@@ -124,6 +134,29 @@ def drive(args, model: str, bag: str) -> float:
             f"the drive did not finish (no report from verification_drive or no bag); end of {log}:\n{tail}"
         )
     return wall
+
+
+def report_json(report, as_built: str, world: str) -> dict:
+    """The report's figures: per path, against the simulator's true pose and against RTK-GNSS."""
+
+    def figures(table):
+        return {
+            name: {
+                "distance_m": f.distance,
+                "distance_error_percent": None if f.distance_error != f.distance_error else f.distance_error,
+                "end_point_m": f.end_point_difference,
+                "heading_deg": math.degrees(f.heading_difference),
+            }
+            for name, f in table.items()
+        }
+
+    return {
+        "robot": report.recording.robot,
+        "as_built": as_built,
+        "world": world,
+        "against_truth": figures(report.figures),
+        "against_rtk_gnss": figures(report.figures_gnss),
+    }
 
 
 def main(argv=None) -> int:
@@ -186,6 +219,10 @@ def main(argv=None) -> int:
     if wall is not None:
         simulated = recording.states[-1][0] - recording.states[0][0]
         print(f"  drive: {simulated:.1f} s simulated in {wall:.1f} s wall, world {args.world}")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(report_json(report, args.as_built, args.world), f, indent=1)
+        print(f"  figures:  {os.path.abspath(args.json)}")
     print(f"  bag:      {bag}")
     print(f"  Figure 8: {figure8(report, os.path.join(out, 'figure8_paths.png'))}")
     print(f"  Figure 9: {figure9(report, os.path.join(out, 'figure9_velocities.png'))}")

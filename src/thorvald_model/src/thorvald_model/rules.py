@@ -173,6 +173,15 @@ def frame_part_dimensions(config: RobotConfig, data: Mapping) -> List[Problem]:
     return problems
 
 
+def steering_offsets(config: RobotConfig, data: Mapping) -> List[Problem]:
+    """A drive that does not steer (type 1) has no steering to be homed off: its offset is 0."""
+    return [
+        Problem(f"motor_drives.{d.name}.steering_offset", d.steering_offset, "must be 0: this drive does not steer")
+        for d in config.drives
+        if not d.steerable and d.steering_offset != 0
+    ]
+
+
 def wheel_layout(config: RobotConfig, data: Mapping) -> List[Problem]:
     """The layout rules every calculator shares (:mod:`thorvald_model.layout`); the calculator's own
     are its to declare and check (thorvald_base's BaseCalculator.layout_rules)."""
@@ -188,6 +197,7 @@ RULES: List[Rule] = [
     io_board_ids,
     pipe_ends_differ,
     frame_part_dimensions,
+    steering_offsets,
     wheel_layout,
 ]
 

@@ -21,6 +21,7 @@ from .constants import BATTERY_KC, DRIVE_STEERED, IO_MAIN_BOARD
 from .errors import Problem
 from .schema import NON_NEGATIVE, POSITIVE, in_range, key, non_negative, one_of
 
+MAX_STEERING_OFFSET = 0.2  # [rad]: a drive's steering_offset beyond it is a broken module, not a homing error
 FRAME_PART_COLORS = ("grey", "dark_grey", "black", "white", "silver", "orange", "red", "green", "blue", "yellow")
 
 
@@ -58,6 +59,13 @@ class Drive:
     # steering angle limit, either side of straight ahead [rad]
     str_lim: float = key(3.078027759, lambda v: 0 < v <= math.pi, "must be in (0, pi] [rad]", runtime=True)
     str_sim_v: float = key(4.0, **POSITIVE, aliases=("str_slm_v",), runtime=True)  # simulated steering speed [rad/s]
+    # Ours: the angle the wheel really stands at when its controller reads 0 [rad] (positive to the
+    # left, as the steering angle): a homing error, measured by calibration (thorvald_base.calibration).
+    # base_driver sends steering - offset and reads reading + offset. Beyond 0.2 rad (about 11 deg)
+    # the module is broken, not mis-homed; a drive that does not steer has none (rules.py).
+    steering_offset: float = key(
+        0.0, lambda v: abs(v) <= MAX_STEERING_OFFSET, f"must be within +-{MAX_STEERING_OFFSET} rad", runtime=True
+    )
     # Ours: the motors' torque limits, for the simulator. About 500 W at 3000 rpm for propulsion
     # (1.6 N m x 42 = 67 N m at the wheel, 336 N at a 0.2 m rim); 1 N m x 42.9 = 43 N m for steering,
     # enough to turn a loaded wheel on the spot on tarmac.

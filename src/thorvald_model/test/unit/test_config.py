@@ -188,6 +188,34 @@ def test_module_parameters_must_be_positive(robot, key, value):
     assert_problem(robot, "motor_drives.drive1." + key, "> 0")
 
 
+def test_steering_offset_is_a_homing_error_of_at_most_0_2_rad(robot):
+    assert parse_robot_config(robot).drives[1].steering_offset == 0.0  # default: homed exactly
+    robot["motor_drives"]["drive1"]["steering_offset"] = -0.2
+    assert parse_robot_config(robot).drives[1].steering_offset == -0.2
+    robot["motor_drives"]["drive1"]["steering_offset"] = 0.21
+    problem = assert_problem(robot, "motor_drives.drive1.steering_offset", "within +-0.2 rad")
+    assert problem.value == 0.21
+
+
+def test_a_drive_that_does_not_steer_has_no_steering_offset(robot):
+    # the rear axle (drive0, drive2) of type-1 drives on one controller
+    robot["motor_drives"]["drive0"].update(type=1, node=5)
+    robot["motor_drives"]["drive2"].update(type=1, node=5, steering_offset=0.01)
+    problem = assert_problem(robot, "motor_drives.drive2.steering_offset", "must be 0", "does not steer")
+    assert problem.value == 0.01
+    robot["motor_drives"]["drive2"]["steering_offset"] = 0.0
+    assert parse_robot_config(robot).drives[2].steering_offset == 0.0
+
+
+def test_steering_offset_may_change_while_the_robot_runs(robot):
+    from thorvald_model.config import RUNTIME_DRIVE_KEYS  # noqa: PLC0415
+
+    assert "steering_offset" in RUNTIME_DRIVE_KEYS
+    config = parse_robot_config(robot).with_drive_param(2, "steering_offset", 0.05)
+    assert config.drives[2].steering_offset == 0.05
+    assert config.to_dict()["motor_drives"]["drive2"]["steering_offset"] == 0.05
+
+
 def test_drive_type_is_0_or_1(robot):
     robot["motor_drives"]["drive1"]["type"] = 2
     assert_problem(robot, "motor_drives.drive1.type", "0 (propulsion/steering) or 1")

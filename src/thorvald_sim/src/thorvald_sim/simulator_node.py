@@ -24,7 +24,18 @@ Private parameters:
 ``~seed``                 seed of every sensor's noise (0): the same seed repeats a run's noise
 ``~datum_file``           a robot_localization datum file: the GNSS reference of robots whose
                           description has neither a reference nor a datum of its own (none)
+``~lockstep``             advance only when every robot's driver has answered the last instant's
+                          drive states with its command (false; see below)
 ========================  ================================================================
+
+Lockstep (``~lockstep`` true): with measured drives, the simulator publishes each robot's
+``drive_states`` with every ``/clock`` tick and steps no further until that robot's base_driver
+(``~lockstep`` true as well) has answered them with a ``drive_commands`` stamped with the same
+instant. The run is then the same on an idle and on a busy machine and at any real-time factor. A
+robot joins with its first command and is let go, with a warning, when it has not answered for
+``LOCKSTEP_TIMEOUT`` seconds of wall time (its driver died or stopped): the others go on, and it
+joins again with its next command. Without lockstep the simulator waits only for robots that lag
+more than ``~max_lag``.
 
 Sensors: the Gazebo sensor blocks of each robot's description (``model_extras``) are simulated
 with the gazebo_ros plugins' topics, frames and parameters (:mod:`thorvald_sim.sensor_blocks`,
@@ -83,6 +94,7 @@ from .world import load_world, resolve_world
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
 MAX_WAIT = 0.5  # [s] wall: the longest the simulator waits at once for a lagging robot
 STREAM_ALIVE = 1.0  # [s] wall: a robot whose commands stopped this long ago is not waited for
+LOCKSTEP_TIMEOUT = 2.0  # [s] wall: a robot in lockstep that has not answered for this long is let go
 EXIT_REFUSED = 1
 
 
@@ -133,6 +145,8 @@ class RobotIO:
         self.command_stamp = None  # [s] simulated time the command is for (its stamp)
         self.command_wall = None  # [s] wall (monotonic) time it arrived
         self.fresh = False
+        self.awaiting = None  # [s] lockstep: the instant of drive states not answered yet
+        self.in_lockstep = False  # lockstep: it answers (joined with its first command)
         self.node = node
         self.sub = rospy.Subscriber(ns + command_topic, BaseState, self.on_command, queue_size=1)
         self.passive = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
@@ -156,12 +170,21 @@ class RobotIO:
             rospy.logwarn_throttle(WARN_PERIOD, "simulator: %s: a non-finite command ignored", self.robot.name)
             return
         limits = list(msg.steer_max_speed) if len(msg.steer_max_speed) == n else None
+        stamp = msg.header.stamp.to_sec()
         with self.lock:
             self.command = (list(msg.steer_pos), list(msg.prop_speed), limits)
             self.command_time = self.node.sim.time
-            self.command_stamp = msg.header.stamp.to_sec()
+            self.command_stamp = stamp
             self.command_wall = time.monotonic()
             self.fresh = True
+        if self.node.lockstep:
+            with self.node.answered:
+                if not self.in_lockstep:
+                    self.in_lockstep = True
+                    rospy.loginfo("simulator: %s in lockstep", self.robot.name)
+                if self.awaiting is not None and stamp >= self.awaiting - 1e-9:
+                    self.awaiting = None
+                self.node.answered.notify_all()
 
     def lagging(self, now: float, max_lag: float) -> bool:
         """Whether this robot's command stream is alive but more than max_lag [s] behind simulated time."""
@@ -211,7 +234,11 @@ class RobotIO:
 
     def publish_drives(self, stamp):
         if self.drive_pub.get_num_connections():  # base_driver with measured drives
-            self.drive_pub.publish(conversions.state_msg(stamp, self.robot.drive_states()))
+            now = stamp.to_sec()
+            if self.node.lockstep and self.in_lockstep:
+                with self.node.answered:
+                    self.awaiting = now
+            self.drive_pub.publish(conversions.state_msg(stamp, self.robot.drive_states(now)))
 
     def close(self):
         self.sub.unregister()
@@ -241,6 +268,8 @@ class SimulatorNode:
             raise ParameterError(f"~seed: {seed!r}: must be a whole number")
         datum_file = str(rospy.get_param("~datum_file", "") or "")
         datum = load_datum(datum_file) if datum_file else None
+        self.lockstep = bool(rospy.get_param("~lockstep", False))
+        self.answered = threading.Condition()  # lockstep: a robot answered, or one was let go
         self.client = p.connect(p.GUI if self.gui else p.DIRECT)
         self.sim = Simulation(self.client, world, physics_rate, tyre, seed=seed, datum=datum)
         self.lock = threading.RLock()
@@ -390,7 +419,9 @@ class SimulatorNode:
                     for io in self.io.values():
                         io.apply(now, self.command_timeout)
                     self.sim.step()
-                    self.publish(self.sim.time)
+                    ticked = self.publish(self.sim.time)
+            if not paused and self.lockstep and ticked:
+                self.wait_for_answers()
             if self.meter is not None:
                 self.publish_performance(time.monotonic())
             if paused:
@@ -407,9 +438,31 @@ class SimulatorNode:
                 elif ahead < -0.5:
                     anchor = None  # too slow to keep up: do not race to catch up afterwards
 
+    def wait_for_answers(self):
+        """Lockstep: holds the world until every robot in lockstep answered its last drive states; a
+        robot silent for LOCKSTEP_TIMEOUT of wall time is let go (it joins again with its next command)."""
+        deadline = time.monotonic() + LOCKSTEP_TIMEOUT
+        with self.answered:
+            while not rospy.is_shutdown():
+                waiting = [io for io in list(self.io.values()) if io.in_lockstep and io.awaiting is not None]
+                if not waiting:
+                    return
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    for io in waiting:
+                        io.in_lockstep, io.awaiting = False, None
+                        rospy.logwarn(
+                            "simulator: %s did not answer its drive states for %.1f s: going on without it "
+                            "(it joins lockstep again with its next command)",
+                            io.robot.name,
+                            LOCKSTEP_TIMEOUT,
+                        )
+                    return
+                self.answered.wait(min(left, 0.1))
+
     def wait_for_followers(self):
         """Holds the world while a robot's commands lag more than ~max_lag behind (at most MAX_WAIT)."""
-        if self.max_lag <= 0:
+        if self.max_lag <= 0 or self.lockstep:
             return
         deadline = None
         while not rospy.is_shutdown():
@@ -432,18 +485,23 @@ class SimulatorNode:
                 return
             time.sleep(0.0005)
 
-    def publish(self, now: float):
+    def publish(self, now: float) -> bool:
+        """What is due at simulated time now; whether /clock ticked. In lockstep the drive states go
+        with every tick, before it: a driver woken by the tick finds them."""
         stamp = rospy.Time.from_sec(now)
-        if self.clock.due(now):
+        ticked = self.clock.due(now)
+        drives = self.drives.due(now) if not self.lockstep else ticked
+        if drives:
+            for io in self.io.values():
+                io.publish_drives(stamp)
+        if ticked:
             self.publish_clock()
         if self.odometry.due(now):
             for io in self.io.values():
                 io.publish_odometry(stamp, self.tf)
-        if self.drives.due(now):
-            for io in self.io.values():
-                io.publish_drives(stamp)
         for io in self.io.values():
             io.sensors.step(now)
+        return ticked
 
     def publish_performance(self, wall: float) -> None:
         """/diagnostics once per ~diagnostics_rate period of wall time: the real-time factor reached, and

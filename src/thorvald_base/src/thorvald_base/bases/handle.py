@@ -8,7 +8,7 @@ python-can's BusABC with ``send``/``_send_internal``).
 Times are seconds on whichever clock the node uses (ROS time, simulated time in simulation).
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 from thorvald_model.config import RobotConfig
@@ -127,6 +127,12 @@ class BaseHandle:
       drives do meanwhile is the handle's business.
     * ``close`` stops the wheels (zero speed, the steering where it was commanded) before the
       hardware is released; after it, nothing is sent.
+    * Each drive's ``steering_offset`` [rad] (the angle the wheel really stands at when its
+      controller reads 0) is applied here, once, for every kind of base: a handle's
+      ``_send_drive_commands`` gets steering - offset and its ``_read_drive_states`` returns what
+      the controller reads; ``read_drive_states`` gives reading + offset, the wheel's true angle.
+      Everything above the handle (drive layer, odometry, joint_states) sees true angles only.
+      Homing is the handle's: it drives the controllers' own 0, wherever that stands.
     """
 
     def __init__(self, config: RobotConfig):
@@ -153,12 +159,27 @@ class BaseHandle:
         if len(commands) != len(self.config.drives):
             raise ThorvaldBaseError(f"expected {len(self.config.drives)} drive commands, got {len(commands)}")
         commands = tuple(commands)
-        self._send_drive_commands(commands, time)
+        # the true angles are kept for stop(), which sends them through here again
+        self._send_drive_commands(self._to_controllers(commands), time)
         self._last_commands, self._last_time = commands, time
 
     def read_drive_states(self, time: float) -> List["MeasuredDrive"]:
-        """The latest measured state of every drive, in drive order."""
-        return self._read_drive_states(time)
+        """The latest measured state of every drive, in drive order (true steering angles)."""
+        states = self._read_drive_states(time)
+        offsets = self._steering_offsets()
+        if not any(offsets):
+            return states
+        return [replace(s, steering=s.steering + offset) if offset else s for s, offset in zip(states, offsets)]
+
+    def _steering_offsets(self) -> Tuple[float, ...]:
+        return tuple(d.steering_offset for d in self.config.drives)
+
+    def _to_controllers(self, commands: Tuple[DriveCommand, ...]) -> Tuple[DriveCommand, ...]:
+        """The commands in the controllers' angles: true steering - steering_offset."""
+        offsets = self._steering_offsets()
+        if not any(offsets):
+            return commands
+        return tuple(DriveCommand(c.steering - offset, c.speed) for c, offset in zip(commands, offsets))
 
     def home_steering(self) -> str:
         """Starts homing the steering of every drive; returns a message for the caller."""

@@ -14,9 +14,16 @@ measured states (:meth:`update`); :meth:`from_params` wires both to the topics t
 Homing points every wheel straight with zero speed until base_driver ends it. Measurements older
 than ``stale_after`` [s] mean the simulator lost the robot: the wheels are sent zero speeds and the
 controllers read as lost.
+
+Rim speeds cross the topics as the simulator converts them: with the radius of the robot it spawned,
+the configuration's ``r_wheel`` when this handle was made (the spawn radius). When set_drive_params
+(or ``~calibration``) changes a drive's ``r_wheel``, the wheel must turn as the new radius says, as a
+CAN controller's would: a rim speed v is sent as v * r_spawn / r_now (the joint turns at v / r_now)
+and a measured one read as v * r_now / r_spawn. Angles (steering, wheel) cross unchanged.
 """
 
 import threading
+from dataclasses import replace
 from typing import Callable, List, Optional, Sequence, Tuple
 
 from ..errors import ParameterError
@@ -39,6 +46,10 @@ class SimulatedJointsBase(BaseHandle):
         self._measured: List[MeasuredDrive] = [MeasuredDrive(0.0, 0.0, 0.0, 0.0) for _ in config.drives]
         self._measured_time: Optional[float] = None
         self._topics = None
+        self._arrived = threading.Condition(self._lock)  # lockstep: new drive states
+        self._last_sent: Optional[Tuple[DriveCommand, ...]] = None  # what went to the simulator last
+        self._spawn_radii: Tuple[float, ...] = tuple(d.r_wheel for d in config.drives)  # [m]
+        self._scales: Tuple[float, ...] = tuple(1.0 for _ in config.drives)  # r_now / r_spawn
 
     @classmethod
     def from_params(cls, config, params, ports=None) -> "SimulatedJointsBase":
@@ -61,6 +72,24 @@ class SimulatedJointsBase(BaseHandle):
         with self._lock:
             self._measured = list(states)
             self._measured_time = time
+            self._arrived.notify_all()
+
+    def wait_for_states(self, after: Optional[float], timeout: float) -> Optional[float]:
+        """Lockstep: the time [s] of drive states newer than after (None: any), waiting up to timeout
+        [s] of wall time for them; None if none came."""
+        with self._arrived:
+            self._arrived.wait_for(
+                lambda: self._measured_time is not None and (after is None or self._measured_time > after + 1e-9),
+                timeout,
+            )
+            t = self._measured_time
+        return t if t is not None and (after is None or t > after + 1e-9) else None
+
+    def answer(self, time: float) -> None:
+        """Lockstep: answers drive states of an instant that is not a cycle of base_driver's with the
+        last commands sent, stamped with that instant (the simulator steps on only when answered)."""
+        if self._send is not None and self._last_sent is not None:
+            self._send(self._last_sent, time)
 
     def online(self, time: float) -> bool:
         with self._lock:
@@ -72,17 +101,20 @@ class SimulatedJointsBase(BaseHandle):
         elif not self.online(time):
             commands = tuple(DriveCommand(c.steering, 0.0) for c in commands)
         if self._send is not None:
-            self._send(commands, time)
+            self._last_sent = tuple(DriveCommand(c.steering, c.speed / k) for c, k in zip(commands, self._scales))
+            self._send(self._last_sent, time)
 
     def _read_drive_states(self, time):
         with self._lock:
-            return list(self._measured)
+            measured = list(self._measured)
+        return [replace(m, speed=m.speed * k) if k != 1.0 else m for m, k in zip(measured, self._scales)]
 
     def _home_steering(self):
         return "homing commands sent"
 
     def _set_params(self, config):
-        pass  # the simulator's joints are the physics; base_driver's parameters do not change them
+        # the simulator's joints are the physics; only the rim speeds' radius follows r_wheel
+        self._scales = tuple(d.r_wheel / r for d, r in zip(config.drives, self._spawn_radii))
 
     def controllers(self, time):
         mode = MODE_ONLINE if self.online(time) else MODE_LOST_CONNECTION

@@ -1,0 +1,126 @@
+"""The calibration file base_driver loads at start (``~calibration``), in the robot file's own shape::
+
+    motor_drives:
+      drive0: {r_wheel: 0.20131, steering_offset: 0.0042}
+      drive2: {r_wheel: 0.19874}
+
+Any drive key set_drive_params may change (thorvald_model's RUNTIME_DRIVE_KEYS) may be given; base_driver
+applies the file through set_drive_params, so each value is checked as the robot file's is. Reading it
+(:func:`load_calibration`) checks it first against the robot it is for, with the robot file's loader
+helpers, and reports every problem with this file's name, the key path, the value and the rule.
+
+Pure: no rospy, no messages.
+"""
+
+from dataclasses import replace
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
+
+import yaml
+
+from thorvald_model.config import RUNTIME_DRIVE_KEYS
+from thorvald_model.errors import MISSING, ConfigError, Problem
+from thorvald_model.keys import DRIVE_KEYS
+from thorvald_model.schema import check_top_level, parse_entry, read_yaml_file
+from thorvald_model.values import RobotConfig
+
+from .estimate import Calibration
+
+WHAT = "calibration file"
+TOP_KEYS = ("motor_drives",)
+# the drive keys a calibration may set, each given or not (None: not given)
+KEYS = tuple(replace(k, default=None) for k in DRIVE_KEYS if k.runtime)
+
+Change = Tuple[int, str, float]  # (drive index, key, value), as set_drive_params takes it
+_KEY_ORDER = {k.name: n for n, k in enumerate(DRIVE_KEYS)}  # the robot file's order of a drive's keys
+
+
+def calibration_dict(calibration: Calibration, extra: Sequence[Change] = ()) -> Dict[str, Any]:
+    """What was estimated, in the robot file's shape (parameters not excited are left out), with
+    extra (drive index, key, value) besides, e.g. what an earlier calibration set and this one kept."""
+    # 9 significant digits: far below any uncertainty, and 0.2016 stays 0.2016 in the file
+    values = {(p.index, p.key): float(f"{p.value:.9g}") for p in calibration.estimated}
+    for index, key, value in extra:
+        values.setdefault((index, key), float(value))
+    drives: Dict[str, Dict[str, float]] = {}
+    for (index, key), value in sorted(values.items(), key=lambda item: (item[0][0], _KEY_ORDER.get(item[0][1], 0))):
+        drives.setdefault(f"drive{index}", {})[key] = value
+    return {"motor_drives": drives}
+
+
+def calibration_yaml(calibration: Calibration, header: str = "", extra: Sequence[Change] = ()) -> str:
+    """The file's text: an optional comment header (each line prefixed with '# '), then the values."""
+    comment = "".join(f"# {line}\n" for line in header.splitlines())
+    return comment + yaml.safe_dump(calibration_dict(calibration, extra), sort_keys=False, default_flow_style=False)
+
+
+def load_calibration(path: str, config: RobotConfig) -> List[Change]:
+    """The changes a calibration file makes to the robot of config, checked; ConfigError naming every
+    problem (file, key path, value, rule)."""
+    return parse_calibration(read_yaml_file(path, WHAT), config, path)
+
+
+def parse_calibration(data: Any, config: RobotConfig, source: str = "<calibration>") -> List[Change]:
+    problems: List[Problem] = []
+    data = check_top_level(data, TOP_KEYS, problems, source=source, what=WHAT)
+    raw = data.get("motor_drives")
+    changes: List[Change] = []
+    names = [d.name for d in config.drives]
+    if raw is not None and not isinstance(raw, Mapping):
+        problems.append(Problem("motor_drives", raw, "must be a mapping of the robot's drives (drive0, ...)"))
+        raw = {}
+    for name, entry in (raw or {}).items():
+        path = f"motor_drives.{name}"
+        if name not in names:
+            problems.append(Problem(path, MISSING, f"is not a drive of the robot (it has {', '.join(names)})"))
+            continue
+        if isinstance(entry, Mapping):
+            fixed = [key for key in entry if _drive_key(key) not in (None, *RUNTIME_DRIVE_KEYS)]
+            for key in fixed:
+                rule = (
+                    "cannot be calibrated: base_driver applies the file as set_drive_params, which changes "
+                    f"only {', '.join(RUNTIME_DRIVE_KEYS)}"
+                )
+                problems.append(Problem(f"{path}.{key}", entry[key], rule))
+            entry = {k: v for k, v in entry.items() if k not in fixed}
+        values = parse_entry(entry, path, KEYS, problems)
+        if values is None:
+            continue
+        index = names.index(name)
+        changes += [(index, key, value) for key, value in values.items() if value is not None]
+    # each value against the robot, as set_drive_params checks it: the robot file's rules
+    candidate = config
+    for index, key, value in changes:
+        try:
+            candidate = candidate.with_drive_param(index, key, value)
+        except ConfigError as e:
+            problems += [p for p in e.problems if p not in problems]
+    if problems:
+        raise ConfigError(source, problems, WHAT)
+    return changes
+
+
+def set_drive_params_command(changes: List[Change], namespace: str = "") -> str:
+    """The rosservice call that applies the changes to a running robot's base_driver (thorvald_msgs
+    DriveParams: params, each DriveParam index, type, value)."""
+    service = "/".join(part for part in (namespace.strip("/"), "base_driver", "set_drive_params") if part)
+    params = ", ".join(f"{{index: {i}, type: '{key}', value: {value!r}}}" for i, key, value in changes)
+    return f'rosservice call /{service} "params: [{params}]"'
+
+
+def _drive_key(name: Any) -> Optional[str]:
+    """The drive key a name of the file means (an alias's key), or None for no drive key."""
+    for k in DRIVE_KEYS:
+        if name == k.name or name in k.aliases:
+            return k.name
+    return None
+
+
+__all__ = [
+    "KEYS",
+    "WHAT",
+    "calibration_dict",
+    "calibration_yaml",
+    "load_calibration",
+    "parse_calibration",
+    "set_drive_params_command",
+]

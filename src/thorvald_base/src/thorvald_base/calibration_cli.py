@@ -1,0 +1,301 @@
+"""``rosrun thorvald_base calibrate_odometry BAG --robot-model FILE``: odometry calibration from a bag.
+
+The bag holds what base_driver read (``.../base_state``) and ground truth: the simulator's
+(``.../odometry/gazebo``) or a real robot's GNSS fix and IMU (``.../gps/fix``, ``.../imu/data``).
+Topics are found by their ending, so a robot in any namespace works; messages are decoded with the
+definitions stored in the bag. By default the simulator's ground truth is used when the bag has it,
+else GNSS and IMU; ``--ground-truth gnss`` asks for GNSS and IMU, as on a real robot.
+
+Prints each drive's calibrated ``r_wheel`` and ``steering_offset`` with their standard uncertainties,
+the parameters the drive did not excite and why, and the odometry error before and after (``--json``:
+the same as one JSON document); writes the calibration file base_driver loads at start
+(``~calibration``, base_bringup.launch's ``calibration:=``), by default ``calibration.yaml`` beside
+the bag, and prints the ``set_drive_params`` call that applies it to the running robot.
+
+The work is thorvald_base.calibration's; this module reads the bag and prints. A bad bag, missing
+topics, a bad robot file or a drive that excites nothing: one line on stderr, exit status 2.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+from dataclasses import dataclass
+from typing import Dict, List, Optional, Tuple
+
+import rosbag
+
+from thorvald_model import ConfigError, load_robot_config
+
+from .calibration import (
+    GNSS,
+    WINDOW,
+    Calibration,
+    DriveRecording,
+    GnssTruth,
+    OdometryError,
+    PoseTruth,
+    as_read_with,
+    calibrate,
+    calibration_yaml,
+    load_calibration,
+    local_metres,
+    odometry_error,
+    set_drive_params_command,
+)
+from .conversions import quaternion_yaw
+from .errors import CalibrationError, ThorvaldBaseError
+
+ENDINGS = {"states": "base_state", "truth": "odometry/gazebo", "fix": "gps/fix", "imu": "imu/data"}
+EXIT_ERROR = 2
+NO_FIX = -1  # sensor_msgs/NavSatStatus STATUS_NO_FIX
+
+
+class BagError(ThorvaldBaseError):
+    """The bag cannot be read, or lacks what calibration needs."""
+
+
+def find_topics(bag, path: str) -> Dict[str, str]:
+    """Each wanted topic by its ending; BagError if several topics end alike."""
+    names = sorted(bag.get_type_and_topic_info().topics)
+    found = {}
+    for key, ending in ENDINGS.items():
+        matches = [n for n in names if n.lstrip("/") == ending or n.endswith("/" + ending)]
+        if len(matches) > 1:
+            raise BagError(f"{path}: several topics end in {ending}: {', '.join(matches)}")
+        if matches:
+            found[key] = matches[0]
+    return found
+
+
+def read_bag(
+    path: str, drives: int, ground_truth: str = "auto", antenna: Tuple[float, float] = (0.0, 0.0)
+) -> Tuple[DriveRecording, object, str, str]:
+    """(drive states, ground truth, a sentence saying which ground truth, the robot's namespace)."""
+    try:
+        bag = rosbag.Bag(path)
+    except (OSError, rosbag.ROSBagException) as e:
+        raise BagError(f"{path}: cannot read the bag: {e}") from None
+    with bag:
+        topics = find_topics(bag, path)
+        names = ", ".join(sorted(bag.get_type_and_topic_info().topics)) or "no topics"
+        has_sim = "truth" in topics
+        has_gnss = "fix" in topics and "imu" in topics
+        if "states" not in topics:
+            raise BagError(f"{path}: no topic ending in {ENDINGS['states']} (the bag has: {names})")
+        use_gnss = ground_truth == "gnss" or (ground_truth == "auto" and not has_sim and has_gnss)
+        if use_gnss and not has_gnss:
+            missing = " and ".join(ENDINGS[k] for k in ("fix", "imu") if k not in topics)
+            raise BagError(f"{path}: no topic ending in {missing} for GNSS ground truth (the bag has: {names})")
+        if not use_gnss and not has_sim:
+            wanted = f"{ENDINGS['truth']} (or {ENDINGS['fix']} and {ENDINGS['imu']})"
+            raise BagError(f"{path}: no ground truth: no topic ending in {wanted} (the bag has: {names})")
+        wanted = [topics["states"]] + ([topics["fix"], topics["imu"]] if use_gnss else [topics["truth"]])
+        states, poses, fixes, yaws = [], [], [], []
+        for topic, msg, _ in bag.read_messages(topics=wanted):
+            stamp = msg.header.stamp.to_sec()
+            if topic == topics["states"]:
+                states.append((stamp, tuple(msg.steer_pos), tuple(msg.prop_speed)))
+            elif topic == topics.get("truth"):
+                p, v = msg.pose.pose, msg.twist.twist
+                poses.append(
+                    (
+                        stamp,
+                        p.position.x,
+                        p.position.y,
+                        quaternion_yaw(p.orientation),
+                        v.linear.x,
+                        v.linear.y,
+                        v.angular.z,
+                    )
+                )
+            elif topic == topics.get("fix"):
+                if msg.status.status > NO_FIX:
+                    fixes.append((stamp, msg.latitude, msg.longitude))
+            else:
+                yaws.append((stamp, quaternion_yaw(msg.orientation)))
+    namespace = topics["states"][: -len(ENDINGS["states"])].rstrip("/")
+    recording = DriveRecording.from_samples(states, drives)
+    if use_gnss:
+        if len(fixes) < 2 or len(yaws) < 2:
+            raise BagError(f"{path}: {len(fixes)} GNSS fixes and {len(yaws)} IMU messages: too few for ground truth")
+        east, north = local_metres([f[1] for f in fixes], [f[2] for f in fixes])
+        truth = GnssTruth.from_samples(list(zip([f[0] for f in fixes], east, north)), yaws, antenna)
+        said = (
+            f"GNSS {topics['fix']} ({len(fixes)} fixes) and the IMU's yaw {topics['imu']} "
+            "(its bias against east estimated)"
+        )
+    else:
+        if len(poses) < 2:
+            raise BagError(f"{path}: {len(poses)} messages on {topics['truth']}: too few for ground truth")
+        truth = PoseTruth.from_samples(poses)
+        said = f"the simulator's {topics['truth']}"
+    return recording, truth, said, namespace
+
+
+def parse_args(argv: Optional[List[str]]):
+    parser = argparse.ArgumentParser(
+        prog="calibrate_odometry",
+        description="Each drive's rolling radius and steering offset from a recorded drive with ground truth.",
+    )
+    parser.add_argument("bag", help="the recorded drive: base_state and ground truth")
+    parser.add_argument("--robot-model", required=True, help="the robot file base_driver ran on")
+    parser.add_argument("--calibration", default="", help="the calibration file base_driver ran with, if any")
+    parser.add_argument(
+        "--ground-truth",
+        choices=("auto", "sim", "gnss"),
+        default="auto",
+        help="the simulator's odometry/gazebo, or GNSS (gps/fix) and IMU yaw (imu/data); auto: the simulator's "
+        "when the bag has it",
+    )
+    parser.add_argument(
+        "--antenna", nargs=2, type=float, default=(0.0, 0.0), metavar=("X", "Y"), help="GNSS antenna in base_link [m]"
+    )
+    parser.add_argument(
+        "--window", type=float, default=WINDOW, help=f"[s] between GNSS fixes compared (default {WINDOW:g})"
+    )
+    parser.add_argument(
+        "--out", default="", help="the calibration file to write (default: calibration.yaml beside the bag)"
+    )
+    parser.add_argument("--json", action="store_true", help="print the results as one JSON document")
+    return parser.parse_args(argv)
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    args = parse_args(argv)
+    try:
+        return run(args)
+    except (ConfigError, ThorvaldBaseError) as e:
+        print(f"calibrate_odometry: {e}", file=sys.stderr)
+        return EXIT_ERROR
+
+
+def run(args) -> int:
+    if not args.window > 0:
+        raise CalibrationError(f"--window: {args.window!r}: must be > 0 [s]")
+    robot = load_robot_config(args.robot_model)
+    in_effect, earlier = robot, []
+    if args.calibration:
+        earlier = load_calibration(args.calibration, robot)
+        for index, key, value in earlier:
+            in_effect = in_effect.with_drive_param(index, key, value)
+    recording, truth, said, namespace = read_bag(args.bag, len(robot.drives), args.ground_truth, args.antenna)
+    calibration = calibrate(in_effect, recording, truth, window=args.window)
+    calibrated = calibration.calibrated(in_effect)
+    bias = calibration.heading_bias[0] if calibration.heading_bias else 0.0
+    before = odometry_error(in_effect, recording, truth, bias)
+    after = odometry_error(calibrated, as_read_with(recording, in_effect, calibrated), truth, bias)
+    out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.bag)), "calibration.yaml")
+    kept = write_file(out, calibration, earlier, args, said)
+    outcome = Outcome(
+        calibration, said, before, after, out, set_drive_params_command(calibration.changes(), namespace), kept
+    )
+    if args.json:
+        print(json.dumps(as_json(outcome), indent=2))
+    else:
+        print_text(outcome)
+    return 0
+
+
+@dataclass(frozen=True)
+class Outcome:
+    calibration: Calibration
+    ground_truth: str  # which, in words
+    before: OdometryError
+    after: OdometryError
+    path: str  # the calibration file written
+    command: str  # the set_drive_params call
+    kept: bool  # the file keeps values of the calibration in effect that were not estimated again
+
+
+def write_file(path: str, calibration: Calibration, earlier, args, said: str) -> bool:
+    """The estimates, over the calibration in effect (what was not estimated again is kept from it)."""
+    estimated = {(p.index, p.key) for p in calibration.estimated}
+    kept = [(i, key, value) for i, key, value in earlier if (i, key) not in estimated]
+    header = (
+        f"odometry calibration of {args.robot_model}\nfrom {os.path.abspath(args.bag)}, ground truth {said}\n"
+        f"base_driver: ~calibration (base_bringup.launch calibration:={path})"
+    )
+    if kept:
+        header += f"\nkept from {args.calibration}: " + ", ".join(f"drive{i} {key}" for i, key, _ in kept)
+    text = calibration_yaml(calibration, header, extra=kept)
+    try:
+        with open(path, "w") as f:
+            f.write(text)
+    except OSError as e:
+        raise CalibrationError(f"{path}: cannot write the calibration file: {e.strerror}") from None
+    return bool(kept)
+
+
+def as_json(outcome: Outcome) -> dict:
+    calibration = outcome.calibration
+    drives: Dict[str, Dict[str, Optional[float]]] = {}
+    for p in calibration.parameters:
+        entry = drives.setdefault(p.drive, {})
+        entry[p.key] = float(p.value)
+        entry[p.key + "_sd"] = _number(p.sd)
+    out = {
+        "drives": drives,
+        "ground_truth": calibration.ground_truth,
+        "ground_truth_source": outcome.ground_truth,
+        "before": _errors(outcome.before),
+        "after": _errors(outcome.after),
+        "not_excited": [
+            {"drive": p.drive, "key": p.key, "value_in_effect": p.in_effect, "reason": p.reason}
+            for p in calibration.not_excited
+        ],
+        "calibration_file": outcome.path,
+        "set_drive_params": outcome.command,
+    }
+    if calibration.heading_bias is not None:
+        out["imu_yaw_bias"] = {"value": calibration.heading_bias[0], "sd": _number(calibration.heading_bias[1])}
+    return out
+
+
+def _errors(error: OdometryError) -> dict:
+    return {
+        "distance_error_percent": _number(error.distance_error_percent),
+        "end_point_m": _number(error.end_point_m),
+        "distance_m": _number(error.distance_m),
+        "truth_distance_m": _number(error.truth_distance_m),
+    }
+
+
+def _number(value: float) -> Optional[float]:
+    return None if value is None or not math.isfinite(value) else float(value)
+
+
+def print_text(outcome: Outcome) -> None:
+    calibration, before, after = outcome.calibration, outcome.before, outcome.after
+    unit = "windows" if calibration.ground_truth == GNSS else "samples"
+    print(f"ground truth: {outcome.ground_truth}; {calibration.observations} {unit}")
+    print(f"{'drive':<8} {'r_wheel [m]':<34} steering_offset [rad]")
+    rows: Dict[str, Dict[str, str]] = {}
+    for p in calibration.parameters:
+        if p.excited:
+            text = f"{p.value:.5f} ± {p.sd:.5f}"
+            if p.key == "steering_offset":
+                text += f" ({math.degrees(p.value):+.3f} deg)"
+            text += f" (was {p.in_effect:g})"
+        else:
+            text = f"{p.in_effect:g} (not excited)"
+        rows.setdefault(p.drive, {})[p.key] = text
+    for drive, row in rows.items():
+        print(f"{drive:<8} {row.get('r_wheel', ''):<34} {row.get('steering_offset', '-')}")
+    if calibration.heading_bias is not None:
+        value, sd = calibration.heading_bias
+        print(f"IMU yaw bias against east: {value:+.5f} ± {sd:.5f} rad ({math.degrees(value):+.3f} deg)")
+    for p in calibration.not_excited:
+        print(f"not excited: {p.drive} {p.key} (left at {p.in_effect:g}): {p.reason}")
+    print(
+        f"odometry against ground truth: before {before.distance_error_percent:+.3f} % of "
+        f"{before.truth_distance_m:.2f} m, end point {before.end_point_m:.3f} m; after "
+        f"{after.distance_error_percent:+.3f} %, end point {after.end_point_m:.3f} m"
+    )
+    kept = " (with what the calibration in effect set and was not estimated again)" if outcome.kept else ""
+    print(f"wrote {outcome.path}{kept}")
+    print(f"apply it to the running robot: {outcome.command}")
+
+
+__all__ = ["BagError", "find_topics", "main", "read_bag"]

@@ -1,0 +1,209 @@
+"""``rosrun thorvald_base calibrate_odometry``: a bag written here (rosbag, no ROS master) with a
+synthetic drive of the standard robot, read back, calibrated, printed and written as base_driver's
+calibration file; and every way it refuses, one line and exit status 2."""
+
+import json
+import math
+import os
+import subprocess
+
+import genpy
+import pytest
+import rosbag
+from base_test_helpers import EXAMPLE_ROBOTS
+from calibration_test_helpers import MIXED, STRAIGHT, synthetic_drive
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import Imu, NavSatFix
+
+from thorvald_base.calibration import load_calibration
+from thorvald_base.calibration.recording import WGS84_A, WGS84_E2
+from thorvald_base.calibration_cli import main
+from thorvald_base.kinematics import Twist
+from thorvald_model import load_robot_config
+from thorvald_msgs.msg import BaseState
+
+STD = next(p for p in EXAMPLE_ROBOTS if p.endswith("thorvald_ii_4wd4ws_std.yaml"))
+RADII = (0.2016, 0.1990, 0.2006, 0.1981)
+OFFSETS = (0.004, -0.006, 0.002, 0.007)
+LAT0, LON0 = 53.268642, -0.524509  # [deg] the Riseholme datum
+
+
+def write_bag(path, drive, *, ns="/robot_1", sim=True, gnss=False, states=True):
+    """The topics odometry_report records: base_state, odometry/gazebo, gps/fix, imu/data."""
+    phi = math.radians(LAT0)
+    w = 1.0 - WGS84_E2 * math.sin(phi) ** 2
+    north_radius, east_radius = WGS84_A * (1 - WGS84_E2) / w**1.5, WGS84_A / math.sqrt(w) * math.cos(phi)
+    with rosbag.Bag(str(path), "w") as bag:
+        if states:
+            rec = drive.recording
+            for t, steering, speed in zip(rec.t, rec.steering, rec.speed):
+                msg = BaseState(steer_pos=list(steering), prop_speed=list(speed))
+                msg.header.stamp = genpy.Time.from_sec(t)
+                bag.write(ns + "/base_state", msg, msg.header.stamp)
+        if sim:
+            truth = drive.pose_truth
+            for n, t in enumerate(truth.t):
+                msg = Odometry()
+                msg.header.stamp = genpy.Time.from_sec(t)
+                msg.pose.pose.position.x, msg.pose.pose.position.y = truth.x[n], truth.y[n]
+                msg.pose.pose.orientation.z = math.sin(truth.yaw[n] / 2)
+                msg.pose.pose.orientation.w = math.cos(truth.yaw[n] / 2)
+                msg.twist.twist.linear.x, msg.twist.twist.linear.y = truth.vx[n], truth.vy[n]
+                msg.twist.twist.angular.z = truth.wz[n]
+                bag.write(ns + "/odometry/gazebo", msg, msg.header.stamp)
+        if gnss:
+            g = drive.gnss_truth
+            for t, east, north in zip(g.t_fix, g.east, g.north):
+                msg = NavSatFix(latitude=LAT0 + math.degrees(north / north_radius))
+                msg.longitude = LON0 + math.degrees(east / east_radius)
+                msg.header.stamp = genpy.Time.from_sec(t)
+                bag.write(ns + "/gps/fix", msg, msg.header.stamp)
+            for t, yaw in zip(g.t_yaw, g.yaw):
+                msg = Imu()
+                msg.header.stamp = genpy.Time.from_sec(t)
+                msg.orientation.z, msg.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+                bag.write(ns + "/imu/data", msg, msg.header.stamp)
+    return str(path)
+
+
+@pytest.fixture(scope="module")
+def std():
+    return load_robot_config(STD)
+
+
+def run(capsys, *args):
+    status = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_json_with_the_simulators_ground_truth(tmp_path, capsys, std):
+    bag = write_bag(tmp_path / "drive.bag", synthetic_drive(std, MIXED, RADII, OFFSETS))
+    status, out, err = run(capsys, bag, "--robot-model", STD, "--json")
+    assert status == 0, err
+    result = json.loads(out)
+    assert result["ground_truth"] == "simulator"
+    assert result["ground_truth_source"] == "the simulator's /robot_1/odometry/gazebo"
+    for i, drive in enumerate(f"drive{i}" for i in range(4)):
+        values = result["drives"][drive]
+        assert values["r_wheel"] == pytest.approx(RADII[i], rel=1e-7)
+        assert values["steering_offset"] == pytest.approx(OFFSETS[i], rel=1e-6)
+        assert 0 <= values["r_wheel_sd"] < 1e-9 and 0 <= values["steering_offset_sd"] < 1e-9
+    assert result["not_excited"] == []
+    assert result["before"]["end_point_m"] > 0.02  # 4 cm after 20 m of MIXED
+    assert result["after"]["end_point_m"] < 1e-6 and abs(result["after"]["distance_error_percent"]) < 1e-6
+    # the file beside the bag, as base_driver reads it, and the call for a running robot
+    assert result["calibration_file"] == str(tmp_path / "calibration.yaml")
+    changes = load_calibration(result["calibration_file"], std)
+    assert [(i, key) for i, key, _ in changes] == [(i, k) for i in range(4) for k in ("r_wheel", "steering_offset")]
+    assert result["set_drive_params"].startswith(
+        "rosservice call /robot_1/base_driver/set_drive_params \"params: [{index: 0, type: 'r_wheel', value: 0.2016"
+    )
+
+
+def test_text_with_gnss_on_a_straight_line_refuses_the_offsets(tmp_path, capsys, std):
+    drive = synthetic_drive(std, STRAIGHT, RADII, OFFSETS, heading_bias=1.2, antenna=(0.3, 0.0))
+    bag = write_bag(tmp_path / "straight.bag", drive, ns="", gnss=True)
+    out_file = tmp_path / "cal" / "straight.yaml"
+    out_file.parent.mkdir()
+    status, out, err = run(
+        capsys, bag, "--robot-model", STD, "--ground-truth", "gnss", "--antenna", 0.3, 0, "--out", out_file
+    )
+    assert status == 0, err
+    lines = out.splitlines()
+    assert lines[0].startswith("ground truth: GNSS /gps/fix (301 fixes) and the IMU's yaw /imu/data")
+    assert lines[1].split() == ["drive", "r_wheel", "[m]", "steering_offset", "[rad]"]
+    assert lines[2].startswith("drive0   0.20160 ± 0.0000") and "(was 0.2)" in lines[2]
+    assert lines[2].endswith("0 (not excited)")
+    refused = [line for line in lines if line.startswith("not excited:")]
+    assert len(refused) == 4
+    assert refused[0].startswith("not excited: drive0 steering_offset (left at 0): a straight line cannot tell")
+    assert any(line.startswith("IMU yaw bias against east: +1.20") for line in lines)
+    assert f"wrote {out_file}" in lines
+    assert lines[-1].startswith("apply it to the running robot: rosservice call /base_driver/set_drive_params")
+    data = out_file.read_text()
+    assert "steering_offset" not in data.split("motor_drives:")[1]  # only what was estimated
+
+
+def test_a_calibration_in_effect_is_where_it_starts_and_what_it_keeps(tmp_path, capsys, std):
+    earlier = tmp_path / "earlier.yaml"
+    earlier.write_text("motor_drives:\n  drive1: {r_wheel: 0.205}\n  drive2: {steering_offset: 0.01}\n")
+    in_effect = std.with_drive_param(1, "r_wheel", 0.205).with_drive_param(2, "steering_offset", 0.01)
+    drive = synthetic_drive(in_effect, STRAIGHT, RADII, OFFSETS, heading_bias=0.4)
+    bag = write_bag(tmp_path / "d.bag", drive, gnss=True, sim=False)  # a real robot's bag: no simulator
+    status, out, err = run(capsys, bag, "--robot-model", STD, "--calibration", earlier, "--json")
+    assert status == 0, err
+    result = json.loads(out)
+    assert result["ground_truth"] == "gnss"  # the only ground truth in the bag
+    assert result["drives"]["drive1"]["r_wheel"] == pytest.approx(RADII[1], rel=1e-4)
+    assert {(p["drive"], p["key"], p["value_in_effect"]) for p in result["not_excited"]} == {
+        ("drive0", "steering_offset", 0.0),
+        ("drive1", "steering_offset", 0.0),
+        ("drive2", "steering_offset", 0.01),
+        ("drive3", "steering_offset", 0.0),
+    }
+    written = load_calibration(result["calibration_file"], std)
+    assert (2, "steering_offset", 0.01) in written  # kept from the calibration in effect
+    assert [v for i, k, v in written if (i, k) == (1, "r_wheel")] == [pytest.approx(RADII[1], rel=1e-4)]
+    assert "kept from" in (tmp_path / "calibration.yaml").read_text()
+
+
+BAD_BAGS = [
+    (lambda p, d: p.write_text("not a bag") or str(p), [], "cannot read the bag"),
+    (lambda p, d: str(p) + ".missing", [], "cannot read the bag"),
+    (lambda p, d: write_bag(p, d, states=False), [], "no topic ending in base_state (the bag has: "),
+    (lambda p, d: write_bag(p, d, sim=False), [], "no ground truth: no topic ending in odometry/gazebo"),
+    (write_bag, ["--ground-truth", "gnss"], "no topic ending in gps/fix and imu/data"),
+]
+
+
+@pytest.mark.parametrize("case", BAD_BAGS, ids=["not a bag", "missing", "no base_state", "no ground truth", "no gnss"])
+def test_a_bag_that_cannot_calibrate_is_one_line_and_status_2(tmp_path, capsys, std, case):
+    make, extra, message = case
+    drive = synthetic_drive(std, STRAIGHT, RADII, OFFSETS)
+    bag = make(tmp_path / "x.bag", drive)
+    status, out, err = run(capsys, bag, "--robot-model", STD, *extra)
+    assert status == 2 and out == ""
+    assert err.startswith(f"calibrate_odometry: {bag}: ") and message in err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "calibration.yaml").exists()
+
+
+def test_a_drive_that_excites_nothing_and_a_bad_robot_file_are_refused(tmp_path, capsys, std):
+    standing = write_bag(tmp_path / "s.bag", synthetic_drive(std, ((5.0, Twist()),), RADII, OFFSETS))
+    status, out, err = run(capsys, standing, "--robot-model", STD)
+    assert status == 2 and out == "" and err.startswith("calibrate_odometry: the recorded drive excites nothing")
+    assert err.count("\n") == 1 and not (tmp_path / "calibration.yaml").exists()
+    bad = tmp_path / "robot.yaml"
+    bad.write_text("motor_drives: {drive0: {node: 1, x: 0, y: 0, r_wheel: -1}}\n")
+    status, _, err = run(capsys, standing, "--robot-model", bad)
+    assert status == 2 and f"{bad}: invalid robot configuration" in err and "motor_drives.drive0.r_wheel" in err
+    another = tmp_path / "other.bag"
+    write_bag(another, synthetic_drive(load_robot_config(_diff_file(tmp_path)), STRAIGHT, (0.2, 0.2), (0, 0)))
+    status, _, err = run(capsys, another, "--robot-model", STD)
+    assert status == 2 and "holds 2 steering angles and 2 rim speeds for a robot of 4 drives" in err
+
+
+def _diff_file(tmp_path):
+    path = tmp_path / "diff.yaml"
+    path.write_text(
+        "base_calculator: pltf_clc_2wdiff::PltfClc2WDiff\n"
+        "motor_drives:\n  drive0: {node: 1, x: 0, y: -0.3, type: 1}\n  drive1: {node: 1, x: 0, y: 0.3, type: 1}\n"
+        "passive_wheels:\n  passive0: {type: caster, x: -0.5, y: 0}\n"
+    )
+    return str(path)
+
+
+def test_rosrun_runs_it_and_refuses_without_a_traceback(tmp_path):
+    not_a_bag = tmp_path / "notes.bag"
+    not_a_bag.write_text("a drive, in words")
+    proc = subprocess.run(
+        ["rosrun", "thorvald_base", "calibrate_odometry", str(not_a_bag), "--robot-model", STD],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=dict(os.environ),
+    )
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.startswith(f"calibrate_odometry: {not_a_bag}: cannot read the bag")
+    assert "Traceback" not in proc.stderr and proc.stdout == ""
