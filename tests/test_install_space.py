@@ -81,7 +81,9 @@ class InstallLaunch:
         self.install = install
         self.proc = subprocess.Popen(
             ["bash", "-c", f"source {shlex.quote(install)}/setup.bash && {script}"],
-            env=clean_env(),
+            # unbuffered: a node roslaunch has to kill at the end still leaves its log lines here
+            # (one CI run lost base_driver's start-up line when its stop took over 15 s)
+            env=dict(clean_env(), PYTHONUNBUFFERED="1"),
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,
