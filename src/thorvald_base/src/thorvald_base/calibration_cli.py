@@ -28,6 +28,7 @@ import rosbag
 
 from thorvald_model import ConfigError, load_robot_config
 
+from .bag_topics import topics_by_ending
 from .calibration import (
     GNSS,
     WINDOW,
@@ -58,15 +59,7 @@ class BagError(ThorvaldBaseError):
 
 def find_topics(bag, path: str) -> Dict[str, str]:
     """Each wanted topic by its ending; BagError if several topics end alike."""
-    names = sorted(bag.get_type_and_topic_info().topics)
-    found = {}
-    for key, ending in ENDINGS.items():
-        matches = [n for n in names if n.lstrip("/") == ending or n.endswith("/" + ending)]
-        if len(matches) > 1:
-            raise BagError(f"{path}: several topics end in {ending}: {', '.join(matches)}")
-        if matches:
-            found[key] = matches[0]
-    return found
+    return topics_by_ending(bag.get_type_and_topic_info().topics, ENDINGS, path, BagError)
 
 
 def read_bag(

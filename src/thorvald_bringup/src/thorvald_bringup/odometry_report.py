@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from typing import List, Optional, Sequence, Tuple
 
 from thorvald_base.kinematics import DriveState
+from thorvald_model.datum import WGS84_A, WGS84_E2, earth_radii  # noqa: F401  (the constants: for tests)
 
 # The paper's figures for its six-wheeled robot on tarmac (section 3.3.2).
 PAPER_TRUTH_DISTANCE = 80.2  # [m] by RTK-GNSS
@@ -36,8 +37,6 @@ REST = 1.5  # [s] after the last command: base_driver's wheels have ramped down
 # robot still and cuts corners by at most 0.1 (sqrt 2 - 1) = 0.04 m a right angle.
 GNSS_SPACING = 0.1
 GNSS_SMOOTHING = 5
-WGS84_A = 6378137.0  # [m]
-WGS84_E2 = 2 * (1 / 298.257223563) - (1 / 298.257223563) ** 2
 SHORT_DRIVE = 0.97  # ground truth below this share of the planned distance: the drive fell behind
 
 
@@ -186,11 +185,9 @@ def gnss_local(
     """A fix [deg] as (x, y) [m] of the simulator's world about (lat0, lon0): hector_gazebo_plugins'
     mapping inverted (its x along the reference heading [deg], y to the left of it: with heading 0,
     x north and y west), with the WGS84 radii of curvature at lat0."""
-    lat = math.radians(lat0)
-    temp = 1.0 / (1.0 - WGS84_E2 * math.sin(lat) ** 2)
-    prime_vertical = WGS84_A * math.sqrt(temp)
-    north = math.radians(latitude - lat0) * prime_vertical * (1.0 - WGS84_E2) * temp
-    west = -math.radians(longitude - lon0) * prime_vertical * math.cos(lat)
+    radius_north, radius_east = earth_radii(lat0)
+    north = math.radians(latitude - lat0) * radius_north
+    west = -math.radians(longitude - lon0) * radius_east
     h = math.radians(heading)
     return math.cos(h) * north - math.sin(h) * west, math.sin(h) * north + math.cos(h) * west
 

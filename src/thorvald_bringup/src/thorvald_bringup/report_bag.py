@@ -10,6 +10,7 @@ reads without its message packages.
 
 import rosbag
 
+from thorvald_base.bag_topics import topics_by_ending
 from thorvald_base.conversions import quaternion_yaw
 
 from .odometry_report import Path, Recording, ReportError, gnss_path
@@ -26,15 +27,8 @@ ENDINGS = {
 
 
 def _topics(bag, path):
-    found = {}
     names = sorted(bag.get_type_and_topic_info().topics)
-    for key, ending in ENDINGS.items():
-        matches = [n for n in names if n.lstrip("/") == ending or n.endswith("/" + ending)]
-        if len(matches) > 1:
-            raise ReportError(f"{path}: several topics end in {ending}: {', '.join(matches)}")
-        if matches:
-            found[key] = matches[0]
-    return found, names
+    return topics_by_ending(names, ENDINGS, path, ReportError), names
 
 
 def read_recording(path: str, robot: str = "") -> Recording:

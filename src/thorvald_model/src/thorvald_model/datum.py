@@ -17,6 +17,20 @@ from .errors import MISSING, ConfigError, Problem
 from .schema import read_yaml_file
 
 WHAT = "datum file"
+# WGS84, as GNSS receivers give latitude and longitude
+WGS84_A = 6378137.0  # [m] equatorial radius
+WGS84_F = 1.0 / 298.257223563  # flattening
+WGS84_E2 = 2 * WGS84_F - WGS84_F * WGS84_F  # first eccentricity squared
+
+
+def earth_radii(latitude: float) -> Tuple[float, float]:
+    """(north, east) [m per radian] of latitude and of longitude at a latitude [deg]: WGS84's
+    meridional radius of curvature, and the prime vertical's times cos(latitude). The simulated GNSS,
+    the odometry report and the calibration convert between metres and degrees with these."""
+    phi = math.radians(latitude)
+    temp = 1.0 / (1.0 - WGS84_E2 * math.sin(phi) ** 2)
+    prime_vertical = WGS84_A * math.sqrt(temp)
+    return prime_vertical * (1.0 - WGS84_E2) * temp, prime_vertical * math.cos(phi)
 
 
 @dataclass(frozen=True)

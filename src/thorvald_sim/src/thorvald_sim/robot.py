@@ -104,7 +104,7 @@ class SimRobot:
             f.write(with_tyre_contact(with_wheel_radii(urdf, radii), wheels, tyre_contact_width))
         try:
             orientation = p.getQuaternionFromEuler((0.0, 0.0, pose.yaw))
-            with _quiet_stdout():
+            with quiet_stdout():
                 self.body = p.loadURDF(
                     f.name, (pose.x, pose.y, pose.z), orientation, flags=LOAD_FLAGS, physicsClientId=client
                 )
@@ -339,8 +339,9 @@ class SimRobot:
 
 
 @contextlib.contextmanager
-def _quiet_stdout():
-    """pybullet's C++ logs every merged link on file descriptor 1: silence it while loading."""
+def quiet_stdout():
+    """pybullet's C++ prints on file descriptor 1 (every merged link while loading, warnings while
+    building shapes): silence it meanwhile."""
     sys.stdout.flush()
     saved = os.dup(1)
     try:

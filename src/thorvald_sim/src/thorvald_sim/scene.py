@@ -54,10 +54,8 @@ leaf green) make snapshots show what is where; pybullet draws its checkered text
 under the ground's colour (a height field gets checks of 1 m drawn for it, as the plane's).
 """
 
-import contextlib
 import math
 import os
-import sys
 import tempfile
 from dataclasses import dataclass
 from typing import Dict, Iterator, List, Optional, Sequence, Tuple
@@ -65,6 +63,7 @@ from typing import Dict, Iterator, List, Optional, Sequence, Tuple
 import numpy as np
 import pybullet as p
 
+from .robot import quiet_stdout
 from .world import (
     GROUND_THICKNESS,
     PATCH_TOP,
@@ -233,7 +232,7 @@ def _ground_with_holes(client: int, world: WorldConfig) -> List[int]:
                 visual = p.createVisualShape(
                     p.GEOM_SPHERE, radius=1e-4, visualFramePosition=(0, 0, -1), physicsClientId=client
                 )
-            with _quiet_stdout():  # pybullet's URDF importer warns that a plane has no default visual; it draws it
+            with quiet_stdout():  # pybullet's URDF importer warns that a plane has no default visual; it draws it
                 body = p.createMultiBody(0, shape, visual, physicsClientId=client)
             if not bodies:
                 p.changeVisualShape(body, -1, rgbaColor=world.ground_rgba, physicsClientId=client)
@@ -251,20 +250,6 @@ def _write_prism(path: str, corners: Sequence[Tuple[float, float]], top: float, 
     lines += [f"f {i + 1} {(i + 1) % n + 1} {n + (i + 1) % n + 1} {n + i + 1}" for i in range(n)]
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
-
-
-@contextlib.contextmanager
-def _quiet_stdout():
-    """pybullet's C++ prints its warnings on file descriptor 1: silence it meanwhile."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    try:
-        with open(os.devnull, "w") as null:
-            os.dup2(null.fileno(), 1)
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)
 
 
 def _height_field(client: int, field: HeightField, surface: Surface, rgba: Rgba) -> int:

@@ -39,6 +39,8 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 import pybullet as p
 
+from thorvald_model.datum import WGS84_A, WGS84_E2, earth_radii  # noqa: F401  (the constants: for tests)
+
 from .description import ParentJoint, link_tree
 from .sensor_blocks import (
     CameraConfig,
@@ -58,9 +60,6 @@ IDENTITY: Transform = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 _FRACTION = operator.itemgetter(2)  # of a rayTestBatch result: (object, link, fraction, ...)
 RAY_BATCH = 16384  # pybullet's largest rayTestBatch (MAX_RAY_INTERSECTION_BATCH_SIZE)
-WGS84_A = 6378137.0  # [m] equatorial radius
-WGS84_F = 1.0 / 298.257223563
-WGS84_E2 = 2 * WGS84_F - WGS84_F * WGS84_F
 
 
 class MountError(Exception):
@@ -292,11 +291,7 @@ class Gnss(Sensor):
         super().__init__(*args, **kwargs)
         c: GpsConfig = self.spec.config
         self.reference = gps_reference(self.spec, datum)
-        lat = math.radians(self.reference[0])
-        temp = 1.0 / (1.0 - WGS84_E2 * math.sin(lat) ** 2)
-        prime_vertical = WGS84_A * math.sqrt(temp)
-        self.radius_north = prime_vertical * (1.0 - WGS84_E2) * temp
-        self.radius_east = prime_vertical * math.cos(lat)
+        self.radius_north, self.radius_east = earth_radii(self.reference[0])
         self.position_error = _ErrorProcess(c.position, self.rng)
         self.velocity_error = _ErrorProcess(c.velocity, self.rng)
         self.last_time: Optional[float] = None

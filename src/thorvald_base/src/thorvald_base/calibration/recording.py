@@ -11,17 +11,14 @@
 Pure: numpy arrays in SI units, no messages. Samples are sorted by time; non-finite ones dropped.
 """
 
-import math
 from dataclasses import dataclass
 from typing import Sequence, Tuple
 
 import numpy as np
 
-from ..errors import CalibrationError
+from thorvald_model.datum import WGS84_A, WGS84_E2, earth_radii  # noqa: F401  (the constants: for tests)
 
-# WGS84, as GNSS receivers give latitude and longitude
-WGS84_A = 6378137.0  # [m] equatorial radius
-WGS84_E2 = 6.69437999014e-3  # first eccentricity squared
+from ..errors import CalibrationError
 
 
 def _sorted(t, *series):
@@ -136,12 +133,9 @@ def local_metres(latitude: Sequence[float], longitude: Sequence[float]) -> Tuple
     lon = np.asarray(longitude, dtype=float)
     if not len(lat):
         return np.zeros(0), np.zeros(0)
-    phi = math.radians(lat[0])
-    w = 1.0 - WGS84_E2 * math.sin(phi) ** 2
-    prime_vertical = WGS84_A / math.sqrt(w)  # east-west radius of curvature
-    meridian = WGS84_A * (1.0 - WGS84_E2) / w**1.5  # north-south radius of curvature
-    east = np.radians(lon - lon[0]) * prime_vertical * math.cos(phi)
-    north = np.radians(lat - lat[0]) * meridian
+    radius_north, radius_east = earth_radii(float(lat[0]))
+    east = np.radians(lon - lon[0]) * radius_east
+    north = np.radians(lat - lat[0]) * radius_north
     return east, north
 
 
