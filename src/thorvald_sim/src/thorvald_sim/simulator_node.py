@@ -96,6 +96,8 @@ MAX_WAIT = 0.5  # [s] wall: the longest the simulator waits at once for a laggin
 STREAM_ALIVE = 1.0  # [s] wall: a robot whose commands stopped this long ago is not waited for
 LOCKSTEP_TIMEOUT = 2.0  # [s] wall: a robot in lockstep that has not answered for this long is let go
 EXIT_REFUSED = 1
+CATCH_UP = 0.05  # [s] wall: behind the pace by more than this (a stall, a busy machine), the pace starts
+# again from now instead of racing to catch up: a burst would read as faster than asked
 
 
 class ParameterError(Exception):
@@ -435,7 +437,7 @@ class SimulatorNode:
                 ahead = anchor[0] + (self.sim.time - anchor[1]) / self.real_time_factor - wall
                 if ahead > 0:
                     time.sleep(ahead)
-                elif ahead < -0.5:
+                elif ahead < -CATCH_UP:
                     anchor = None  # too slow to keep up: do not race to catch up afterwards
 
     def wait_for_answers(self):
