@@ -75,6 +75,7 @@ from .calibration import load_calibration
 from .core import BaseDriverCore, PoseCovariance
 from .diagnostics import LinkWatch, base_statuses
 from .errors import ParameterError, ThorvaldBaseError
+from .node_names import Names, Throttle
 from .params import PARAMETER_NAMES, DriverParams
 from .plugins import load_calculator
 
@@ -83,10 +84,11 @@ STATUS_PERIOD = 1.0  # [s] between battery_data / motor_controller_data messages
 EXIT_REFUSED = 1  # exit status when the node refuses to start
 
 
-def load_config(raw: dict, params: DriverParams):
+def load_config(raw: dict, params: DriverParams, names: Names = None):
     """The robot configuration: the private namespace's, else the ~robot_model file's."""
+    names = names or Names()
     if any(key not in PARAMETER_NAMES for key in raw):
-        source = params.robot_model or rospy.resolve_name("~") + " parameters"
+        source = params.robot_model or rospy.resolve_name(names.param()) + " parameters"
         return parse_robot_config(raw, source, ignore=PARAMETER_NAMES), False
     if not params.robot_model:
         raise ParameterError(
@@ -102,6 +104,7 @@ class RosDriveTopics(DriveTopics):
     def __init__(self, command_topic: str, state_topic: str):
         self.pub = rospy.Publisher(command_topic, BaseState, queue_size=1)
         self.state_topic = state_topic
+        self.throttle = Throttle()
         self.sub = None
 
     def send(self, commands, time, drives):
@@ -116,7 +119,7 @@ class RosDriveTopics(DriveTopics):
             try:
                 on_states(conversions.measured_drives(msg), msg.header.stamp.to_sec())
             except ValueError as e:
-                rospy.logwarn_throttle(WARN_PERIOD, "base_driver: %s ignored: %s", self.state_topic, e)
+                self.throttle.warn("base_driver: %s ignored: %s", self.state_topic, e)
 
         self.sub = rospy.Subscriber(self.state_topic, BaseState, on_message, queue_size=1)
 
@@ -127,15 +130,24 @@ class RosDriveTopics(DriveTopics):
 
 
 class RosPorts(Ports):
+    def __init__(self, names: Names):
+        self.names = names
+
     def drive_topics(self, command_topic, state_topic):
-        return RosDriveTopics(command_topic, state_topic)
+        return RosDriveTopics(self.names.topic(command_topic), self.names.topic(state_topic))
 
 
 class BaseDriverNode:
-    def __init__(self):
-        raw = rospy.get_param("~", {})
+    def __init__(self, names: Names = None, tf_broadcaster=None):
+        """names: where this robot's names are (default: this process's node); tf_broadcaster: one
+        to share (a fleet_driver's), else the node makes its own when it broadcasts odom."""
+        self.names = names = names or Names()
+        # log lines name the robot when several share a process
+        self.label = "base_driver" if names.private == "~" else names.node
+        self.throttle = Throttle()
+        raw = rospy.get_param(names.param(), {})
         self.params = params = DriverParams.from_dict(raw)
-        self.config, from_file = load_config(raw, params)
+        self.config, from_file = load_config(raw, params, names)
         self.tf_prefix = params.tf_prefix
         self.odom_frame = params.odom_frame_id
         self.base_frame = params.base_frame
@@ -148,7 +160,7 @@ class BaseDriverNode:
             )
         self.covariance = PoseCovariance(params.twist_covariance)
         calculator = load_calculator(self.config, estimator=params.estimator, projection=params.projection)
-        handle = create_base_handle(self.config, params, RosPorts())
+        handle = create_base_handle(self.config, params, RosPorts(names))
         try:
             self.core = BaseDriverCore(self.config, calculator, handle, command_timeout=params.command_timeout)
             if params.calibration:
@@ -160,52 +172,52 @@ class BaseDriverNode:
         self.config = self.core.config
         if from_file:
             for key, value in self.config.to_dict().items():
-                rospy.set_param("~" + key, value)
+                rospy.set_param(names.param(key), value)
         self.lock = threading.Lock()
         self.joint_names = conversions.joint_names(self.config.drives, self.tf_prefix)
 
-        self.odom_pub = rospy.Publisher("odometry/base_raw", Odometry, queue_size=10)
-        self.joint_pub = rospy.Publisher("joint_states", JointState, queue_size=10)
-        self.state_pub = rospy.Publisher("base_state", BaseState, queue_size=10)
-        self.command_pub = rospy.Publisher("joint_commands", BaseState, queue_size=10)
-        self.battery_pub = rospy.Publisher("battery_data", BatteryArray, queue_size=1)
-        self.controller_pub = rospy.Publisher("motor_controller_data", ControllerArray, queue_size=1)
-        self.io_pub = rospy.Publisher("io_data", IOArray, queue_size=1)
+        self.odom_pub = rospy.Publisher(names.topic("odometry/base_raw"), Odometry, queue_size=10)
+        self.joint_pub = rospy.Publisher(names.topic("joint_states"), JointState, queue_size=10)
+        self.state_pub = rospy.Publisher(names.topic("base_state"), BaseState, queue_size=10)
+        self.command_pub = rospy.Publisher(names.topic("joint_commands"), BaseState, queue_size=10)
+        self.battery_pub = rospy.Publisher(names.topic("battery_data"), BatteryArray, queue_size=1)
+        self.controller_pub = rospy.Publisher(names.topic("motor_controller_data"), ControllerArray, queue_size=1)
+        self.io_pub = rospy.Publisher(names.topic("io_data"), IOArray, queue_size=1)
         self.battery_state_pubs = {
-            b.id: rospy.Publisher("battery_state/" + b.name, BatteryState, queue_size=1)
+            b.id: rospy.Publisher(names.topic("battery_state/" + b.name), BatteryState, queue_size=1)
             for b in self.config.present_batteries
         }
         self.diagnostics_pub = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=1)
-        self.frames_base_pub = rospy.Publisher("can_frames_base_r", CANFrame, queue_size=200)
-        self.frames_device_pub = rospy.Publisher("can_frames_device_r", CANFrame, queue_size=200)
-        rospy.Subscriber("can_frames_device_t", CANFrame, self.on_device_frame, queue_size=100)
-        self.tf = tf2_ros.TransformBroadcaster() if self.enable_tf else None
+        self.frames_base_pub = rospy.Publisher(names.topic("can_frames_base_r"), CANFrame, queue_size=200)
+        self.frames_device_pub = rospy.Publisher(names.topic("can_frames_device_r"), CANFrame, queue_size=200)
+        rospy.Subscriber(names.topic("can_frames_device_t"), CANFrame, self.on_device_frame, queue_size=100)
+        self.tf = (tf_broadcaster or tf2_ros.TransformBroadcaster()) if self.enable_tf else None
         self.gazebo_odom = None
         if params.passthrough_gazebo_odometry:
-            rospy.Subscriber("odometry/gazebo", Odometry, self.on_gazebo_odometry, queue_size=10)
-        rospy.Subscriber("cmd_vel", Twist, self.on_cmd_vel, queue_size=1)
-        rospy.Service("~home_steering", Trigger, self.srv_home_steering)
-        rospy.Service("~reset_base_odom", Trigger, self.srv_reset_odom)
-        rospy.Service("~safety_stop", SetBool, self.srv_safety_stop)
-        rospy.Service("~set_drive_params", DriveParams, self.srv_set_drive_params)
-        rospy.Service("~mute_extra_can_device_commands", SetBool, self.srv_mute)
-        rospy.Service("~setup_motor_controller", MotorControllerSetup, self.srv_setup_motor_controller)
-        rospy.Service("~set_home_count_current_pos_zero", CanID, self.srv_set_home_count)
+            rospy.Subscriber(names.topic("odometry/gazebo"), Odometry, self.on_gazebo_odometry, queue_size=10)
+        rospy.Subscriber(names.topic("cmd_vel"), Twist, self.on_cmd_vel, queue_size=1)
+        rospy.Service(names.param("home_steering"), Trigger, self.srv_home_steering)
+        rospy.Service(names.param("reset_base_odom"), Trigger, self.srv_reset_odom)
+        rospy.Service(names.param("safety_stop"), SetBool, self.srv_safety_stop)
+        rospy.Service(names.param("set_drive_params"), DriveParams, self.srv_set_drive_params)
+        rospy.Service(names.param("mute_extra_can_device_commands"), SetBool, self.srv_mute)
+        rospy.Service(names.param("setup_motor_controller"), MotorControllerSetup, self.srv_setup_motor_controller)
+        rospy.Service(names.param("set_home_count_current_pos_zero"), CanID, self.srv_set_home_count)
         boards = handle.io_config
         for board in boards:
             for relay in range(2):
-                rospy.Service(f"~io{board.id}_rl{relay}", SetBool, self._relay_service(board.id, relay))
+                rospy.Service(names.param(f"io{board.id}_rl{relay}"), SetBool, self._relay_service(board.id, relay))
         main = next((b for b in boards if b.is_main), None)
         if main is not None:
             # the original's names of the main board's relays, 1-based (LCAS: setRl1 lights, setRl2 AC)
             for relay in range(2):
-                rospy.Service(f"~setRl{relay + 1}", SetBool, self._relay_service(main.id, relay))
+                rospy.Service(names.param(f"setRl{relay + 1}"), SetBool, self._relay_service(main.id, relay))
         self._last_status_publish = None
         self.link_watch = LinkWatch()
         for warning in self.config.warnings:
-            rospy.logwarn("base_driver: %s", warning.format(self.config.source))
+            rospy.logwarn(self.label + ": %s", warning.format(self.config.source))
         rospy.loginfo(
-            "base_driver: %d drives, calculator %s, base %s, %.0f Hz, odom tf %s",
+            self.label + ": %d drives, calculator %s, base %s, %.0f Hz, odom tf %s",
             len(self.config.drives),
             self.config.base_calculator,
             params.handle,
@@ -221,7 +233,7 @@ class BaseDriverNode:
         if problems:
             raise ParameterError(f"~calibration: {path}: " + "; ".join(problems))
         rospy.loginfo(
-            "base_driver: calibration %s: %s",
+            self.label + ": calibration %s: %s",
             path,
             ", ".join(f"drive{i} {key} {value:g}" for i, key, value in changes) or "nothing to change",
         )
@@ -231,7 +243,7 @@ class BaseDriverNode:
         with self.lock:
             refused = self.core.set_command(msg.linear.x, msg.linear.y, msg.angular.z, rospy.get_time())
         if refused:
-            rospy.logwarn_throttle(WARN_PERIOD, "base_driver: %s", refused)
+            self.throttle.warn(self.label + ": %s", refused)
 
     def on_gazebo_odometry(self, msg):
         if self.gazebo_odom is None:
@@ -244,12 +256,12 @@ class BaseDriverNode:
         try:
             frame = conversions.frame_of(msg)
         except ValueError as e:
-            rospy.logwarn_throttle(WARN_PERIOD, "base_driver: can_frames_device_t: a frame refused: %s", e)
+            self.throttle.warn(self.label + ": can_frames_device_t: a frame refused: %s", e)
             return
         with self.lock:
             problem = self.core.handle.relay(frame)
         if problem:
-            rospy.logwarn_throttle(WARN_PERIOD, "base_driver: can_frames_device_t: %s", problem)
+            self.throttle.warn(self.label + ": can_frames_device_t: %s", problem)
 
     def srv_mute(self, req):
         with self.lock:
@@ -291,7 +303,7 @@ class BaseDriverNode:
     def srv_safety_stop(self, req):
         with self.lock:
             message = self.core.safety_stop(req.data)
-        rospy.logwarn("base_driver: %s", message)
+        rospy.logwarn(self.label + ": %s", message)
         return SetBoolResponse(True, message)
 
     def srv_set_drive_params(self, req):
@@ -299,7 +311,7 @@ class BaseDriverNode:
         with self.lock:
             applied, problems = self.core.set_drive_params(changes)
         for problem in problems:
-            rospy.logwarn("base_driver: set_drive_params: %s", problem)
+            rospy.logwarn(self.label + ": set_drive_params: %s", problem)
         message = f"{applied} of {len(changes)} parameter(s) applied" + ("; " + "; ".join(problems) if problems else "")
         return DriveParamsResponse(applied, message)
 
@@ -307,38 +319,20 @@ class BaseDriverNode:
     def spin(self):
         if self.lockstep:
             return self.spin_lockstep()
-        rate = rospy.Rate(self.rate)
-        last = None
-        while not rospy.is_shutdown():
-            now = rospy.Time.now()
-            if now == last:
-                # On simulated time a late cycle's rate.sleep() returns at once, before /clock moved:
-                # one cycle per instant, not two identical ones.
-                try:
-                    rospy.sleep(0.5 / self.rate)
-                except rospy.ROSTimeMovedBackwardsException:
-                    last = None
-                except rospy.ROSInterruptException:
-                    break
-                continue
-            last = now
-            with self.lock:
-                if self.core.closed:
-                    break
-                result = self.core.step(now.to_sec())
-                if result.odometry.valid:
-                    self.covariance.update(result.odometry)
-            self.publish(result, now)
-            if result.twist_changed:
-                rospy.logwarn_throttle(
-                    WARN_PERIOD, "base_driver: this robot cannot realise the commanded twist; driving a realisable one"
-                )
-            try:
-                rate.sleep()
-            except rospy.ROSTimeMovedBackwardsException:
-                rospy.logwarn("base_driver: time moved backwards; odometry integration restarts")
-            except rospy.ROSInterruptException:
-                break
+        return spin_together([self], self.rate)
+
+    def cycle(self, now) -> bool:
+        """One cycle of the loop at rospy time now: step, publish. False once the handle is closed."""
+        with self.lock:
+            if self.core.closed:
+                return False
+            result = self.core.step(now.to_sec())
+            if result.odometry.valid:
+                self.covariance.update(result.odometry)
+        self.publish(result, now)
+        if result.twist_changed:
+            self.throttle.warn(self.label + ": this robot cannot realise the commanded twist; driving a realisable one")
+        return True
 
     def spin_lockstep(self):
         """The loop in lockstep with the simulator: each arrival of drive states at instant t is either
@@ -374,11 +368,16 @@ class BaseDriverNode:
         # core.config, not self.config: set_drive_params may have changed r_wheel since start-up
         drives = self.core.config.drives
         channels = [d.channel for d in drives]
-        self.command_pub.publish(
-            conversions.command_msg(stamp, result.commands, [d.max_steering_speed for d in drives], channels)
-        )
-        self.state_pub.publish(conversions.state_msg(stamp, result.states, result.stopped_by == "homing", channels))
-        self.joint_pub.publish(conversions.drive_joint_state_msg(stamp, self.joint_names, drives, result.states))
+        # Each message is built only when somebody reads it (50 a second per topic; in a fleet the
+        # building costs more than the driving): nothing is latched, so nobody misses one.
+        if self.command_pub.get_num_connections():
+            self.command_pub.publish(
+                conversions.command_msg(stamp, result.commands, [d.max_steering_speed for d in drives], channels)
+            )
+        if self.state_pub.get_num_connections():
+            self.state_pub.publish(conversions.state_msg(stamp, result.states, result.stopped_by == "homing", channels))
+        if self.joint_pub.get_num_connections():
+            self.joint_pub.publish(conversions.drive_joint_state_msg(stamp, self.joint_names, drives, result.states))
         if self.gazebo_odom is None:
             self.publish_odometry(result.odometry, stamp)
         handle = self.core.handle
@@ -410,8 +409,8 @@ class BaseDriverNode:
     def publish_diagnostics(self, stamp, controllers, batteries, link):
         """/diagnostics: one status per motor controller and battery, one for the bus."""
         for change in self.link_watch.changes(link):
-            rospy.logwarn("base_driver: %s", change)
-        statuses = base_statuses(rospy.get_namespace().strip("/"), controllers, batteries, link)
+            rospy.logwarn(self.label + ": %s", change)
+        statuses = base_statuses(self.names.robot, controllers, batteries, link)
         if statuses:
             msg = DiagnosticArray(
                 status=[
@@ -424,7 +423,9 @@ class BaseDriverNode:
 
     def publish_odometry(self, odometry, stamp):
         if not odometry.valid:
-            rospy.logwarn_throttle(WARN_PERIOD, "base_driver: odometry calculation failed (non-finite drive states)")
+            self.throttle.warn(self.label + ": odometry calculation failed (non-finite drive states)")
+            return
+        if self.tf is None and not self.odom_pub.get_num_connections():
             return
         msg = conversions.odometry_msg(
             stamp,
@@ -445,6 +446,46 @@ class BaseDriverNode:
         """
         with self.lock:
             self.core.shutdown(rospy.get_time())
+
+
+def spin_together(drivers, rate: float, on_failure=None) -> None:
+    """The loop of one or several drivers at rate [Hz] of rospy time, one cycle each per instant.
+
+    A driver whose handle is closed leaves the loop; one whose cycle raises is handed to
+    on_failure (a fleet_driver stops that robot and drives on) or, without it, stops the loop.
+    """
+    drivers = list(drivers)
+    ticker = rospy.Rate(rate)
+    last = None
+    while drivers and not rospy.is_shutdown():
+        now = rospy.Time.now()
+        if now == last:
+            # On simulated time a late cycle's rate.sleep() returns at once, before /clock moved:
+            # one cycle per instant, not two identical ones.
+            try:
+                rospy.sleep(0.5 / rate)
+            except rospy.ROSTimeMovedBackwardsException:
+                last = None
+            except rospy.ROSInterruptException:
+                break
+            continue
+        last = now
+        for driver in list(drivers):
+            try:
+                alive = driver.cycle(now)
+            except Exception:
+                if on_failure is None:
+                    raise
+                on_failure(driver)
+                alive = False
+            if not alive:
+                drivers.remove(driver)
+        try:
+            ticker.sleep()
+        except rospy.ROSTimeMovedBackwardsException:
+            rospy.logwarn("%s: time moved backwards; odometry integration restarts", rospy.get_name())
+        except rospy.ROSInterruptException:
+            break
 
 
 def main():

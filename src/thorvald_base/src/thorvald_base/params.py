@@ -8,6 +8,7 @@ factory and its handles never see the raw dictionary.
 """
 
 import math
+import re
 from dataclasses import dataclass, fields
 from typing import Any, Mapping
 
@@ -119,3 +120,26 @@ def _positive(values: Mapping, name: str, default: float, unit: str) -> float:
 
 
 __all__ = ["DEFAULT_BITRATE", "PARAMETER_NAMES", "DriverParams"]
+
+
+def robot_namespaces(value) -> list:
+    """~robots as absolute namespaces ending in "/": ["/robot_1/", ...]; ParameterError if empty or
+    not names."""
+    if isinstance(value, str):
+        items = [v for v in re.split(r"[\s,]+", value) if v]
+    elif isinstance(value, (list, tuple)):
+        items = [str(v) for v in value]
+    else:
+        raise ParameterError(f"~robots: {value!r}: give the robots' namespaces, a list or a string")
+    if not items:
+        raise ParameterError("~robots: <missing>: give the robots' namespaces (robot_1 robot_2 ...)")
+    out = []
+    for item in items:
+        name = item.strip("/")
+        if not re.fullmatch(r"[A-Za-z][\w/]*", name):
+            raise ParameterError(f"~robots: {item!r}: not a ROS namespace")
+        ns = "/" + name + "/"
+        if ns in out:
+            raise ParameterError(f"~robots: {item!r} given twice")
+        out.append(ns)
+    return out

@@ -15,27 +15,32 @@ from std_msgs.msg import Bool
 
 from .errors import ThorvaldBaseError
 from .mux import TwistMux, parse_sources
+from .node_names import Names
 
 
 class TwistMuxNode:
-    def __init__(self):
-        inputs = parse_sources(rospy.get_param("~topics", None), "~topics")
-        locks = parse_sources(rospy.get_param("~locks", None), "~locks")
+    def __init__(self, names: Names = None):
+        """names: where this mux's names are (default: this process's node; a fleet_driver gives each
+        robot's)."""
+        self.names = names = names or Names()
+        inputs = parse_sources(rospy.get_param(names.param("topics"), None), "~topics")
+        locks = parse_sources(rospy.get_param(names.param("locks"), None), "~locks")
         if not inputs:
             raise ThorvaldBaseError(
                 "~topics: no input topic configured: give at least one {name, topic, timeout, priority}"
             )
         self.mux = TwistMux(inputs, locks)
-        self.pub = rospy.Publisher("cmd_vel_out", Twist, queue_size=1)
+        self.pub = rospy.Publisher(names.topic("cmd_vel_out"), Twist, queue_size=1)
         self.diag_pub = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=1)
-        self.subs = [rospy.Subscriber(s.topic, Twist, self.on_input, s.name, queue_size=1) for s in inputs]
-        self.subs += [rospy.Subscriber(s.topic, Bool, self.on_lock, s.name, queue_size=1) for s in locks]
-        rate = float(rospy.get_param("~diagnostics_rate", 1.0))
+        self.subs = [rospy.Subscriber(names.topic(s.topic), Twist, self.on_input, s.name, queue_size=1) for s in inputs]
+        self.subs += [rospy.Subscriber(names.topic(s.topic), Bool, self.on_lock, s.name, queue_size=1) for s in locks]
+        rate = float(rospy.get_param(names.param("diagnostics_rate"), 1.0))
         if rate > 0:
             self.timer = rospy.Timer(rospy.Duration(1.0 / rate), self.publish_diagnostics)
         # the topics as subscribed, remappings applied (a launch file may remap nav_vel)
         rospy.loginfo(
-            "twist_mux: inputs %s; locks %s",
+            "%s: inputs %s; locks %s",
+            "twist_mux" if names.private == "~" else names.node,
             ", ".join(f"{s.name} ({sub.resolved_name}, priority {s.priority})" for s, sub in zip(inputs, self.subs)),
             ", ".join(
                 f"{s.name} ({sub.resolved_name}, priority {s.priority})"
@@ -53,7 +58,7 @@ class TwistMuxNode:
 
     def publish_diagnostics(self, _event=None):
         status = self.mux.status(rospy.get_time())
-        diag = DiagnosticStatus(name=rospy.get_name() + ": twist mux", hardware_id="none")
+        diag = DiagnosticStatus(name=self.names.node + ": twist mux", hardware_id="none")
         selected = status["selected"]
         diag.level = DiagnosticStatus.OK if selected else DiagnosticStatus.WARN
         diag.message = f"relaying {selected}" if selected else "no live input"

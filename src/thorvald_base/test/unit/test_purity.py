@@ -18,6 +18,9 @@ PACKAGES = ["thorvald_base", "thorvald_bringup", "thorvald_model", "thorvald_sim
 NOT_PURE = {
     "thorvald_base.base_driver_node": "a node",
     "thorvald_base.twist_mux_node": "a node",
+    "thorvald_base.fleet_driver_node": "a node",
+    "thorvald_base.state_publisher": "fleet_driver's /tf publisher",
+    "thorvald_base.node_names": "where a node's names are (rospy's resolution)",
     "thorvald_base.verification_node": "a node",
     "thorvald_model.place_robot": "a node",
     "thorvald_sim.simulator_node": "a node",

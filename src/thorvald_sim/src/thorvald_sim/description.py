@@ -15,6 +15,8 @@ from typing import Callable, Dict, Iterable, Mapping, Optional, Tuple
 
 from thorvald_model.datum import Datum, parse_datum
 from thorvald_model.errors import ConfigError
+from thorvald_model.joint_tree import Origin, ParentJoint, UrdfError  # noqa: F401  (Origin: for the sensors)
+from thorvald_model.joint_tree import link_tree as _link_tree
 
 
 class DescriptionError(Exception):
@@ -168,51 +170,13 @@ def _datum(element) -> Optional[Datum]:
         raise DescriptionError(str(e)) from None
 
 
-@dataclass(frozen=True)
-class Origin:
-    """A joint's <origin>: translation [m], then roll, pitch, yaw [rad] about fixed axes."""
-
-    xyz: Tuple[float, float, float] = (0.0, 0.0, 0.0)
-    rpy: Tuple[float, float, float] = (0.0, 0.0, 0.0)
-
-
-@dataclass(frozen=True)
-class ParentJoint:
-    """How a link hangs from its parent: the joint's name, type and origin."""
-
-    parent: str
-    joint: str
-    type: str
-    origin: Origin
-
-
 def link_tree(xml: str) -> Dict[str, ParentJoint]:
-    """Each child link's joint to its parent (the root link has none)."""
-    root = ET.fromstring(xml)
-    tree = {}
-    for j in root.findall("joint"):
-        parent, child = j.find("parent"), j.find("child")
-        if parent is None or child is None:
-            continue
-        origin = j.find("origin")
-        xyz = _triple(origin.get("xyz") if origin is not None else None, f"joint {j.get('name')} origin xyz")
-        rpy = _triple(origin.get("rpy") if origin is not None else None, f"joint {j.get('name')} origin rpy")
-        tree[child.get("link", "")] = ParentJoint(
-            parent.get("link", ""), j.get("name", ""), j.get("type", ""), Origin(xyz, rpy)
-        )
-    return tree
-
-
-def _triple(text: Optional[str], what: str) -> Tuple[float, float, float]:
-    if not text:
-        return (0.0, 0.0, 0.0)
+    """Each child link's joint to its parent (the root link has none): thorvald_model.joint_tree's,
+    its errors as DescriptionError."""
     try:
-        values = tuple(float(v) for v in text.split())
-    except ValueError:
-        values = ()
-    if len(values) != 3:
-        raise DescriptionError(f"{what}: {text!r} is not 3 numbers")
-    return values  # type: ignore[return-value]
+        return _link_tree(xml)
+    except UrdfError as e:
+        raise DescriptionError(str(e)) from None
 
 
 def with_tyre_contact(xml: str, wheel_joints: Iterable[str], width: float) -> str:

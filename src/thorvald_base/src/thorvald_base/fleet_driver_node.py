@@ -1,0 +1,129 @@
+"""The ``fleet_driver`` node: the base_driver and twist_mux of every robot of a fleet, in one process.
+
+A fleet brought up with ``fleet_driver:=true`` (thorvald_sim robot.launch, multi_sim.launch) has
+each robot's parameters where its own base_driver and twist_mux would read them
+(``/robot_1/base_driver/...``, ``/robot_1/twist_mux/...``), and this one process drives them all:
+the same topics, services, parameters and frames per robot as the robot's own processes give, one
+``/clock`` subscription and one process instead of two per robot (bench/fleet.py measures both).
+
+Private parameters:
+
+=================  ===============================================================================
+``~robots``        the robots' namespaces: a list, or one string separated by spaces or commas
+``~cmd_vel``       where each base_driver reads its commands, in its robot's namespace
+                   (default ``twist_mux/cmd_vel``: twist_mux's output, as robot.launch remaps it)
+``~joint_states``  where each base_driver publishes its joint states, in its robot's namespace
+                   (default ``joint_states``, as the simulated robot.launch remaps it)
+``~twist_mux``     run each robot's twist_mux too (default true)
+``~robot_state_publisher``  publish each robot's joints on /tf and /tf_static from its
+                   ``robot_description`` and ``joint_states`` as robot_state_publisher does
+                   (default true; thorvald_base.state_publisher), so the fleet needs none per robot
+``~publish_frequency``  robot_state_publisher's parameter of that name [Hz] (default 50)
+=================  ===============================================================================
+
+One robot's fault stays in that robot: a robot whose configuration is refused is left out with a
+fatal log naming it and the others run (the node exits 1 only when it drives none); a robot whose
+loop fails is stopped (zero-speed commands) and logged, and the others drive on; a robot's bad
+command or stale drive states are refused or stop that robot alone, as in its own base_driver.
+"""
+
+import sys
+import threading
+import traceback
+
+import rospy
+import tf2_ros
+
+from thorvald_model import ConfigError
+
+from .base_driver_node import EXIT_REFUSED, BaseDriverNode, spin_together
+from .errors import ThorvaldBaseError
+from .node_names import Names
+from .params import robot_namespaces
+from .state_publisher import FleetStatePublisher
+from .twist_mux_node import TwistMuxNode
+
+
+class Robot:
+    """One robot of the fleet: its base_driver and its twist_mux."""
+
+    def __init__(self, ns: str, cmd_vel: str, joint_states: str, *, with_mux: bool, tf_broadcaster, state=None):
+        self.ns = ns
+        if state is not None:
+            state.add(ns)  # first: a robot without a usable description is refused before it drives
+        self.driver = BaseDriverNode(
+            Names(ns, ns + "base_driver/", {"cmd_vel": cmd_vel, "joint_states": joint_states}), tf_broadcaster
+        )
+        self.mux = None
+        if with_mux:
+            try:
+                self.mux = TwistMuxNode(Names(ns, ns + "twist_mux/", {"cmd_vel_out": "twist_mux/cmd_vel"}))
+            except ThorvaldBaseError:
+                self.driver.shutdown()
+                raise
+
+
+def stop_failed(driver) -> None:
+    """A driver whose cycle raised: logged with its traceback, its wheels stopped; the rest drive on."""
+    rospy.logerr(
+        "fleet_driver: %s failed; its wheels are stopped, the other robots drive on:\n%s",
+        driver.label,
+        traceback.format_exc(),
+    )
+    driver.shutdown()
+
+
+def run_lockstep(driver) -> None:
+    try:
+        driver.spin_lockstep()
+    except Exception:  # one robot's failure stays in that robot
+        stop_failed(driver)
+
+
+def loops(drivers) -> list:
+    """The threads that drive them: one loop for all drivers of one rate (a wake-up per instant of
+    /clock for the lot, not one per robot), one thread each in lockstep (each waits for its own drive
+    states)."""
+    by_rate = {}
+    threads = []
+    for driver in drivers:
+        if driver.lockstep:
+            threads.append(threading.Thread(target=run_lockstep, args=(driver,), daemon=True))
+        else:
+            by_rate.setdefault(driver.rate, []).append(driver)
+    for rate, group in by_rate.items():
+        threads.append(threading.Thread(target=spin_together, args=(group, rate, stop_failed), daemon=True))
+    return threads
+
+
+def main():
+    rospy.init_node("fleet_driver")
+    try:
+        namespaces = robot_namespaces(rospy.get_param("~robots", ""))
+        cmd_vel = str(rospy.get_param("~cmd_vel", "twist_mux/cmd_vel"))
+        joint_states = str(rospy.get_param("~joint_states", "joint_states"))
+        with_mux = bool(rospy.get_param("~twist_mux", True))
+        state = None
+        if rospy.get_param("~robot_state_publisher", True):
+            state = FleetStatePublisher(float(rospy.get_param("~publish_frequency", 50.0)))
+    except ThorvaldBaseError as e:
+        rospy.logfatal("fleet_driver: refusing to start: %s", e)
+        sys.exit(EXIT_REFUSED)
+    broadcaster = tf2_ros.TransformBroadcaster()
+    robots = []
+    for ns in namespaces:
+        try:
+            robots.append(Robot(ns, cmd_vel, joint_states, with_mux=with_mux, tf_broadcaster=broadcaster, state=state))
+        except (ConfigError, ThorvaldBaseError) as e:
+            rospy.logfatal("fleet_driver: %sbase_driver refusing to start: %s", ns, e)
+    if not robots:
+        rospy.logfatal("fleet_driver: no robot to drive")
+        sys.exit(EXIT_REFUSED)
+    if state is not None:
+        state.publish_static()
+    for robot in robots:
+        rospy.on_shutdown(robot.driver.shutdown)
+    rospy.loginfo("fleet_driver: driving %s", " ".join(r.ns.strip("/") for r in robots))
+    for thread in loops(r.driver for r in robots):
+        thread.start()
+    rospy.spin()
