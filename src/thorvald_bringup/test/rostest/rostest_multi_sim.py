@@ -96,6 +96,15 @@ class MultiSimTest(unittest.TestCase):
             self.assertAlmostEqual(t.transform.translation.x, x, places=6)
             self.assertAlmostEqual(t.transform.translation.y, y, places=6)
 
+    def test_each_robots_links_are_on_tf_from_world(self):
+        """robot_state_publisher's work (its node, or fleet_driver's): each robot's wheel links hang
+        from its base_link, and the whole chain reaches world (the simulator's odom -> base_link)."""
+        for r, (x, y) in SPAWN.items():
+            t = self.buffer.lookup_transform("world", f"{r}/wheel0_link", rospy.Time(0), rospy.Duration(10.0))
+            base = position(self.truth[r].get())
+            wheel = (t.transform.translation.x, t.transform.translation.y)
+            self.assertLess(math.dist(wheel, (x + base[0], y + base[1])), 1.5, f"{r}/wheel0_link far from its robot")
+
 
 if __name__ == "__main__":
     rospy.init_node("multi_sim_test")

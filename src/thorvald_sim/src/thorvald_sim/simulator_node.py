@@ -209,7 +209,7 @@ class RobotIO:
 
     def publish_odometry(self, stamp, tf):
         """odometry/gazebo (and its tf), joint_states of the passive joints: only what somebody reads."""
-        if self.odom_pub.get_num_connections() or self.publish_tf:
+        if self.odom_pub.get_num_connections() or (self.publish_tf and tf.get_num_connections()):
             self._publish_odometry(stamp, tf)
         if self.passive and self.joint_pub.get_num_connections():
             states = self.robot.joint_states(self.passive)
@@ -231,7 +231,7 @@ class RobotIO:
             angular=angular,
         )
         self.odom_pub.publish(msg)
-        if self.publish_tf:
+        if self.publish_tf and tf.get_num_connections():
             tf.publish(TFMessage([conversions.odometry_transform(msg)]))
 
     def publish_drives(self, stamp):
