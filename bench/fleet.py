@@ -10,7 +10,8 @@ as multi_sim.launch brings them up (sim_robot_in_world.launch: the model, robot_
 base_driver on drives measured from the simulated joints, twist_mux, the spawn, the world -> odom
 transform), 6 m apart. Every robot gets its own twist on its nav_vel at 10 Hz (a circle of its
 own: 0.30 to 0.38 m/s, +-0.3 rad/s). With ``--lidar-robots`` every robot also carries a planar
-lidar of 720 beams at 10 Hz (bench/data/fleet_lidar.xacro, a gazebo_ros laser block).
+lidar of 720 beams at 10 Hz (bench/data/fleet_lidar.xacro, a gazebo_ros laser block), and each
+scan is read (the simulator measures a sensor only while somebody reads it).
 
 Stacks: ``per-robot`` is the stack as it is (base_driver and twist_mux processes per robot);
 ``fleet`` runs every robot's base_driver and twist_mux in one fleet_driver process
@@ -30,6 +31,7 @@ Exits 1 when a target is missed.
 """
 
 import argparse
+import json
 import os
 import re
 import signal
@@ -109,6 +111,10 @@ def cpu_by_role(pids, master_pid):
     return totals
 
 
+def _ignore(_msg):
+    pass
+
+
 def case(n: int, lidar: bool, stack: str, seconds: float, *, master_pid: int, rtf: float = 1.0):
     """{figure: value} of one fleet."""
     import rospy  # noqa: PLC0415
@@ -138,6 +144,9 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master_pid: int, rt
         for k in range(n)
     ]
     pubs = [rospy.Publisher(f"/r{k}/nav_vel", Twist, queue_size=1) for k in range(n)]
+    # the simulator measures a sensor only while somebody reads it: each lidar gets a reader, which
+    # takes the message's bytes without decoding them (its CPU, the benchmark's, is not counted)
+    scans = [rospy.Subscriber(f"/r{k}/scan", rospy.AnyMsg, _ignore, queue_size=1) for k in range(n)] if lidar else []
     twists = []
     for k in range(n):
         twist = Twist()
@@ -166,10 +175,22 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master_pid: int, rt
     try:
         threading.Thread(target=command, daemon=True).start()
         deadline = time.monotonic() + 90 + 10 * n
+        retry = time.monotonic() + 30
         while len(moving) < n:
             check()
+            missing = [k for k in range(n) if k not in moving]
             if time.monotonic() > deadline:
-                raise RuntimeError(f"{label}: only {len(moving)} robots publish odometry; see {output.name}")
+                names = " ".join(f"r{k}" for k in missing)
+                raise RuntimeError(f"{label}: no odometry from {names}; see {output.name}")
+            if time.monotonic() > retry:
+                # rospy gives up a connection that failed while the machine was swamped (a hundred
+                # processes starting): subscribe again to the robots not heard from
+                for k in missing:
+                    odometry[k].unregister()
+                    odometry[k] = rospy.Subscriber(
+                        f"/r{k}/odometry/base_raw", Odometry, lambda m, k=k: moving.add(k), queue_size=1
+                    )
+                retry = time.monotonic() + 30
             time.sleep(0.5)
         for sub in odometry:
             sub.unregister()
@@ -197,7 +218,7 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master_pid: int, rt
         return {"rtf": simulated / (w1 - w0), "wall": w1 - w0, **per_robot}
     finally:
         stop.set()
-        for endpoint in subs + odometry + pubs:
+        for endpoint in subs + odometry + pubs + scans:
             endpoint.unregister()
         stop_launch(proc)
         os.unlink(launch.name)
@@ -250,6 +271,8 @@ def main() -> int:
         "--real-time-factor", type=float, default=1.0, help="the simulator's pace (1; 0: as fast as it can)"
     )
     parser.add_argument("--plot", help="save the real-time factor against fleet size as this PNG")
+    parser.add_argument("--json", help="write every case's figures to this file")
+    parser.add_argument("--merge", help="figures of earlier cases (a --json file) to plot and judge with these")
     args = parser.parse_args()
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     cases = [(n, False) for n in args.robots] + [(n, True) for n in args.lidar_robots]
@@ -260,6 +283,11 @@ def main() -> int:
         + f" {'total':>7} {'/solver':>8} {'sim/solv':>8}"
     )
     results = {}
+    if args.merge:
+        with open(args.merge) as f:
+            for row in json.load(f):
+                results.setdefault((row["lidar"], row["stack"]), {})[row["robots"]] = row["figures"]
+                print_row(row["robots"], row["lidar"], row["stack"], row["figures"])
     procs = Processes()
     log = open(os.devnull, "w")
     try:
@@ -276,6 +304,14 @@ def main() -> int:
         rospy.signal_shutdown("done")
         procs.stop_all()
         log.close()
+    if args.json:
+        rows = [
+            {"robots": n, "lidar": lidar, "stack": stack, "figures": r}
+            for (lidar, stack), points in sorted(results.items())
+            for n, r in sorted(points.items())
+        ]
+        with open(args.json, "w") as f:
+            json.dump(rows, f, indent=1)
     if args.plot:
         plot(results, args.plot)
     return 0 if verdicts(results) else 1
