@@ -90,6 +90,15 @@ class StatePublisherTest(unittest.TestCase):
         wait_for(lambda: all(p.get_num_connections() for p in cls.pubs.values()), "both publishers not read")
         wait_for(lambda: cls.tf.sub.get_num_connections() >= 2, "/tf not published by both")
 
+    last_stamp = rospy.Time()
+
+    def fresh_stamp(self):
+        """Now, or 0.1 s past the last stamp any test sent, whichever is later: both publishers skip
+        a message within 1 / publish_frequency of their last, and the tests run in one process."""
+        stamp = max(rospy.Time.now(), StatePublisherTest.last_stamp + rospy.Duration(0.1))
+        StatePublisherTest.last_stamp = stamp + rospy.Duration(0.05)  # the interval test sends up to 50 ms on
+        return stamp
+
     def send(self, positions, stamp):
         for prefix, pub in self.pubs.items():
             msg = JointState(name=[prefix + "/" + n for n in positions], position=list(positions.values()))
@@ -116,7 +125,7 @@ class StatePublisherTest(unittest.TestCase):
             positions = {
                 n: rng.uniform(-math.pi, math.pi) if "susp" not in n else rng.uniform(-0.05, 0.05) for n in self.moving
             }
-            stamp = rospy.Time.now()
+            stamp = self.fresh_stamp()
             self.send(positions, stamp)
             for n in self.moving:
                 child = self.child[n]
@@ -129,7 +138,7 @@ class StatePublisherTest(unittest.TestCase):
 
     def test_a_message_within_the_publish_interval_is_not_used(self):
         positions = dict.fromkeys(self.moving, 0.1)
-        stamp = rospy.Time.now()
+        stamp = self.fresh_stamp()
         self.send(positions, stamp)
         child = self.child[self.moving[0]]
         wait_for(lambda: self.tf.find("fleet/" + child, stamp) is not None, "the first message used")
