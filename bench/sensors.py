@@ -2,28 +2,33 @@
 """What simulated sensors cost, side by side in one run: each sensor in the simulator node against raw
 pybullet doing the same rays or renders, and four robots carrying sensors, subscribed and not.
 
-    python bench/sensors.py [--seconds S] [--robots N]
+    python bench/sensors.py [--seconds S] [--robots N] [--part 1|2] [--stack per-robot|fleet|both]
 
 Sensors (bench/data/bench_sensors.xacro on the standard robot): planar lidar 720 beams at 40 Hz,
 IMU 100 Hz, RTK-GNSS 10 Hz, RGB-D camera 320 x 240 at 10 Hz, 16 x 440 3D lidar at 10 Hz, p3d 50 Hz.
 
-1. Per sensor: raw is pybullet alone, in this process, casting the same rays (rayTestBatch, the
-   same beams from the same mount) or rendering the same image (getCameraImage, tiny renderer) at
-   the sensor's rate between the physics steps of a simulated second (240 steps: a ray test right
-   after a step finds the collision structures as the simulator's does, not hot in the cache from
-   the last ray test), CPU of the rays or renders per simulated second; node is the simulator's own
-   figure for that sensor (its /diagnostics: CPU spent measuring, converting and publishing, per
-   simulated second) while it is the one sensor read (the IMU and GNSS: with all read). Target:
-   node within 1.3 times raw.
+1. Per sensor: raw is pybullet alone, in a process of its own running beside the simulator node
+   while the node is measured (the two see the same machine over the same seconds), casting the
+   same rays and taking their ranges (rayTestBatch from the same mount, each hit's fraction) or
+   rendering the same image (getCameraImage, tiny renderer) at the sensor's rate between the
+   physics steps of a simulated second (240 steps: a ray test right after a step finds the
+   collision structures as the simulator's does, not hot in the cache from the last ray test), CPU
+   of that work per simulated second; the same raw work is measured again with nothing beside it
+   ("raw alone"). Node is the simulator's own figure for that sensor (its /diagnostics: CPU spent
+   measuring, converting and publishing, per simulated second) while it is the one sensor read
+   (the IMU and GNSS: with all read). Target: node within 1.3 times raw.
 2. N robots (4) with these sensors, the simulator as fast as it can: real-time factor and the
    simulator's CPU per simulated second with no sensor subscribed, with the planar lidar, IMU and
    GNSS of every robot subscribed, and with everything subscribed; and the same robots without
-   sensors. Targets: with lidar, IMU and GNSS subscribed at least 2 times real time; an unsubscribed
-   sensor costs under 1 % of the simulator's CPU.
+   sensors. Once with each robot's own base_driver, twist_mux and robot_state_publisher
+   (per-robot), once with one fleet_driver for all (fleet). Targets: with lidar, IMU and GNSS
+   subscribed at least 2 times real time; an unsubscribed sensor costs under 1 % of the
+   simulator's CPU.
 """
 
 import argparse
 import functools
+import json
 import os
 import signal
 import subprocess
@@ -31,6 +36,7 @@ import sys
 import tempfile
 import threading
 import time
+from typing import Optional
 
 import numpy as np
 from base_driver import Processes, cpu_seconds, free_port, start_master
@@ -55,9 +61,10 @@ SENSOR_TOPICS = {  # of the sensors with a raw reference: what reading one alone
 # ---------------------------------------------------------------------------------------------
 # 1. raw pybullet, no ROS
 # ---------------------------------------------------------------------------------------------
-def raw_costs(seconds: float):
-    """{sensor name: CPU [s] per simulated second} of raw pybullet doing each sensor's work at its rate,
-    on the standard robot with the bench sensors in the flat world."""
+def raw_costs(wall: float, only=None, stop: Optional[threading.Event] = None):
+    """{sensor name: CPU [s] per simulated second} of raw pybullet doing each sensor's work at its rate
+    (of the sensor named only, or of each with a raw reference), on the standard robot with the bench
+    sensors in the flat world, for wall seconds each (or until stop is set)."""
     import pybullet as p  # noqa: PLC0415
 
     from thorvald_model.description import generate_urdf  # noqa: PLC0415
@@ -74,17 +81,18 @@ def raw_costs(seconds: float):
         out = {}
         for sensor in robot.sensors:
             spec = sensor.spec
-            if spec.kind not in ("laser", "multilayer", "camera", "depth"):
+            if spec.name not in SENSOR_TOPICS or only not in (None, spec.name):
                 continue
             origin, quat = sensor.pose()  # the same mount, computed once: raw does nothing else
-            readings = max(1, round(seconds * spec.rate))
             steps = max(1, round(PHYSICS_RATE / spec.rate))  # physics steps between two readings
             if spec.kind in ("laser", "multilayer"):
                 m = np.asarray(p.getMatrixFromQuaternion(quat)).reshape(3, 3)
                 d = sensor.directions.reshape(-1, 3) @ m.T
                 starts = (np.asarray(origin) + d * spec.config.range_min).tolist()
                 ends = (np.asarray(origin) + d * spec.config.range_max).tolist()
-                work = functools.partial(p.rayTestBatch, starts, ends, physicsClientId=c)
+
+                def work(starts=starts, ends=ends):  # the rays and their ranges: a lidar's reading
+                    return [hit[2] for hit in p.rayTestBatch(starts, ends, physicsClientId=c)]
 
             else:
                 cfg = spec.config
@@ -94,26 +102,58 @@ def raw_costs(seconds: float):
                     renderer=p.ER_TINY_RENDERER, flags=p.ER_NO_SEGMENTATION_MASK, physicsClientId=c,
                 )  # fmt: skip
 
-            spent = 0.0
-            for _ in range(readings):
+            spent, readings, end = 0.0, 0, time.monotonic() + wall
+            while readings == 0 or (time.monotonic() < end and not (stop and stop.is_set())):
                 for _ in range(steps):
                     p.stepSimulation(physicsClientId=c)
                 start = time.thread_time()
                 work()
                 spent += time.thread_time() - start
+                readings += 1
             out[spec.name] = spent / (readings / spec.rate)
         return out
     finally:
         p.disconnect(c)
 
 
+class RawBeside:
+    """Raw pybullet doing one sensor's work in a process of its own while the node is measured: the
+    two see the same machine (what else runs, how busy it is) over the same seconds."""
+
+    def __init__(self, name: str):
+        self.proc = subprocess.Popen(
+            [sys.executable, os.path.abspath(__file__), "--raw", name],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+
+    def result(self) -> float:
+        """Stops it; its CPU per simulated second."""
+        out, _ = self.proc.communicate("stop\n", timeout=600)
+        return float(json.loads(out.strip().splitlines()[-1])["cpu"])
+
+
+def raw_worker(name: str) -> int:
+    """--raw NAME: raw_costs of that sensor until a line (or the end) on stdin; prints {"cpu": ...}."""
+    stop = threading.Event()
+    threading.Thread(target=lambda: (sys.stdin.readline(), stop.set()), daemon=True).start()
+    cpu = raw_costs(float("inf"), only=name, stop=stop)[name]
+    print(json.dumps({"cpu": cpu}), flush=True)
+    return 0
+
+
 # ---------------------------------------------------------------------------------------------
 # 2. the simulator node
 # ---------------------------------------------------------------------------------------------
-def node_case(n: int, seconds: float, port: int, phases, sensors: bool = True):
+def node_case(
+    n: int, seconds: float, port: int, phases, *, sensors: bool = True, fleet_driver: bool = False, beside=None
+):
     """One launch of n robots, measured in phases one after the other, each reading its own topics:
     per phase (real-time factor, simulator CPU [s] per simulated second, {sensor: node CPU per
-    simulated second} of robot r0). A phase: topic suffixes to read on every robot, "all", or ()."""
+    simulated second} of robot r0, raw CPU per simulated second beside it or None). A phase: topic
+    suffixes to read on every robot, "all", or (); beside: per phase, the sensor whose raw work runs
+    beside the node while the phase is measured (RawBeside), or None."""
     import rospy  # noqa: PLC0415
     from diagnostic_msgs.msg import DiagnosticArray  # noqa: PLC0415
     from rosgraph_msgs.msg import Clock  # noqa: PLC0415
@@ -121,7 +161,7 @@ def node_case(n: int, seconds: float, port: int, phases, sensors: bool = True):
 
     env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
     extras = f'<arg name="model_extras" value="{EXTRAS}"/>' if sensors else ""
-    launch = fleet_launch([(SPACING * k, 0) for k in range(n)], robot_args=extras)
+    launch = fleet_launch([(SPACING * k, 0) for k in range(n)], robot_args=extras, fleet_driver=fleet_driver)
     clock = {"t": None}
     sub = rospy.Subscriber("/clock", Clock, lambda m: clock.__setitem__("t", m.clock.to_sec()))
     per_sensor = {}
@@ -148,15 +188,22 @@ def node_case(n: int, seconds: float, port: int, phases, sensors: bool = True):
             if proc.poll() is not None:
                 raise RuntimeError(f"the launch stopped; see {output.name}")
             time.sleep(0.2)
-        time.sleep(5.0)  # every robot spawned
+        spawned = {f"/r{k}/odometry/gazebo" for k in range(n)}  # the simulator's topics of a spawned robot
+        while not spawned <= {t for t, _ in rospy.get_published_topics()}:
+            if time.time() > deadline or proc.poll() is not None:
+                raise RuntimeError(f"not every robot spawned; see {output.name}")
+            time.sleep(0.5)
+        time.sleep(5.0)  # their nodes up and settled
         sim_pid = [pid for pid in children(proc.pid) if "/simulator" in cmdline(pid).split(" __")[0]]
-        for subscribe in phases:
+        for subscribe, raw_name in zip(phases, beside or [None] * len(phases)):
             if subscribe == "all":
                 topics = [t for t, _ in rospy.get_published_topics() if t.startswith("/r") and _sensor_topic(t)]
             else:
                 topics = [f"/r{k}/{s}" for k in range(n) for s in subscribe]
             readers = [rospy.Subscriber(t, AnyMsg, lambda _m: None, queue_size=1) for t in topics]
             time.sleep(3.0)
+            raw = RawBeside(raw_name) if raw_name else None
+            time.sleep(2.0 if raw else 0.0)  # its robot loaded, its readings begun
             per_sensor.clear()
             t0, w0, c0 = clock["t"], time.perf_counter(), sum(cpu_seconds(p, 0.0) for p in sim_pid)
             measuring.set()
@@ -164,11 +211,12 @@ def node_case(n: int, seconds: float, port: int, phases, sensors: bool = True):
                 time.sleep(0.1)
             measuring.clear()
             t1, w1, c1 = clock["t"], time.perf_counter(), sum(cpu_seconds(p, 0.0) for p in sim_pid)
+            raw_cpu = raw.result() if raw else None
             simulated = t1 - t0
             if simulated <= 0:
                 raise RuntimeError(f"simulated time stood still; see {output.name}")
             sensors_cpu = {k: float(np.median(v)) for k, v in per_sensor.items()}
-            results.append((simulated / (w1 - w0), (c1 - c0) / simulated, sensors_cpu))
+            results.append((simulated / (w1 - w0), (c1 - c0) / simulated, sensors_cpu, raw_cpu))
             for r in readers:
                 r.unregister()
             readers = []
@@ -187,11 +235,74 @@ def _sensor_topic(topic: str) -> bool:
     return any(topic.endswith(s) for s in ("scan", "imu/data", "gps/fix", "velodyne_points", "image_raw", "points"))
 
 
+def sensors_part(seconds: float, port: int) -> bool:
+    """Part 1; whether its target was met."""
+    names = list(SENSOR_TOPICS)
+    phases = [SENSOR_TOPICS[name] for name in names] + ["all"]
+    raw, in_node = {}, {}
+    beside = [*names, None]  # the "all" phase: no raw beside it
+    for name, (_, _, cpu, raw_cpu) in zip(beside, node_case(1, seconds, port, phases, beside=beside)):
+        if name:
+            raw[name] = raw_cpu
+        for key, value in cpu.items():  # each sensor from its own phase (read alone); the rest from "all"
+            in_node.setdefault(key, value)
+    alone = raw_costs(2.0)  # the same raw work again, with nothing beside it
+    print("1. each sensor: CPU per simulated second, raw pybullet beside the simulator node (one robot)")
+    print(f"{'sensor':>14} {'raw alone':>10} {'raw beside':>11} {'node [s]':>9} {'node/raw':>9}")
+    worst = 0.0
+    for name, raw_cpu in raw.items():
+        node_cpu = next((v for k, v in in_node.items() if k.split(" ", 1)[1] == name), float("nan"))
+        ratio = node_cpu / raw_cpu
+        worst = max(worst, ratio)
+        print(f"{name:>14} {alone[name]:>10.4f} {raw_cpu:>11.4f} {node_cpu:>9.4f} {ratio:>8.2f}x")
+    for key, node_cpu in in_node.items():
+        if key.split(" ", 1)[1] not in raw:
+            print(f"{key.split(' ', 1)[1]:>14} {'-':>10} {'-':>11} {node_cpu:>9.4f}")
+    verdict = worst <= TARGET_RATIO
+    print(f"target: node within {TARGET_RATIO} x raw: {'met' if verdict else 'MISSED'} (worst {worst:.2f} x)\n")
+    return verdict
+
+
+def robots_part(n: int, seconds: float, port: int, stack: str) -> bool:
+    """Part 2 with one stack ("per-robot": base_driver, twist_mux and robot_state_publisher per robot;
+    "fleet": one fleet_driver for all); whether its targets were met."""
+    fleet = stack == "fleet"
+    print(f"2. {n} robots, the simulator as fast as it can, {stack} stack")
+    print(f"{'case':>36} {'RTF':>7} {'sim CPU/s':>10}")
+    cases = [
+        ("no sensors fitted", (), False),
+        ("sensors fitted, none read", (), True),
+        ("planar lidar, IMU, GNSS read", LIGHT, True),
+        ("every sensor read", "all", True),
+    ]
+    results = {}
+    for label, subscribe, fitted in cases:
+        [(rtf, cpu, _, _)] = node_case(n, seconds, port, [subscribe], sensors=fitted, fleet_driver=fleet)
+        results[label] = (rtf, cpu)
+        print(f"{label:>36} {rtf:>6.2f}x {cpu:>9.3f}s", flush=True)
+    bare, idle = results["no sensors fitted"][1], results["sensors fitted, none read"][1]
+    per_sensor_idle = (idle - bare) / (6 * n) / bare
+    light = results["planar lidar, IMU, GNSS read"][0]
+    v1, v2 = light >= TARGET_RTF, per_sensor_idle < TARGET_IDLE
+    print(f"target: lidar, IMU and GNSS read on {n} robots at least {TARGET_RTF:g} x real time: "
+          f"{'met' if v1 else 'MISSED'} ({light:.2f} x)")  # fmt: skip
+    print(f"target: an unread sensor under {TARGET_IDLE:.0%} of the simulator's CPU: "
+          f"{'met' if v2 else 'MISSED'} ({per_sensor_idle:+.2%} each, {6 * n} sensors)\n")  # fmt: skip
+    return v1 and v2
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--seconds", type=float, default=10.0, help="simulated seconds measured per case")
     parser.add_argument("--robots", type=int, default=4)
+    parser.add_argument("--part", type=int, choices=(1, 2), help="only this part (default: both)")
+    parser.add_argument("--raw", metavar="SENSOR", help=argparse.SUPPRESS)  # RawBeside's worker
+    parser.add_argument(
+        "--stack", choices=("per-robot", "fleet", "both"), default="both", help="the robots' stack in part 2"
+    )
     args = parser.parse_args()
+    if args.raw:
+        return raw_worker(args.raw)
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     procs = Processes()
     log = open(os.devnull, "w")
@@ -199,49 +310,11 @@ def main() -> int:
     try:
         port = free_port(11411)
         start_master(procs, log, port, "bench_sensors", master_only=True)
-        raw = raw_costs(args.seconds)
-        in_node = {}
-        for _, _, cpu in node_case(1, args.seconds, port, [SENSOR_TOPICS[name] for name in raw] + ["all"]):
-            for key, value in cpu.items():  # each sensor from its own phase (read alone); the rest from "all"
-                in_node.setdefault(key, value)
-        print("1. each sensor: CPU per simulated second, raw pybullet and in the simulator node (one robot)")
-        print(f"{'sensor':>14} {'raw [s]':>9} {'node [s]':>9} {'node/raw':>9}")
-        worst = 0.0
-        for name, raw_cpu in raw.items():
-            node_cpu = next((v for k, v in in_node.items() if k.split(" ", 1)[1] == name), float("nan"))
-            ratio = node_cpu / raw_cpu
-            worst = max(worst, ratio)
-            print(f"{name:>14} {raw_cpu:>9.4f} {node_cpu:>9.4f} {ratio:>8.2f}x")
-        for key, node_cpu in in_node.items():
-            if key.split(" ", 1)[1] not in raw:
-                print(f"{key.split(' ', 1)[1]:>14} {'-':>9} {node_cpu:>9.4f}")
-        verdict = worst <= TARGET_RATIO
-        ok &= verdict
-        print(f"target: node within {TARGET_RATIO} x raw: {'met' if verdict else 'MISSED'} (worst {worst:.2f} x)\n")
-
-        n = args.robots
-        print(f"2. {n} robots, the simulator as fast as it can")
-        print(f"{'case':>36} {'RTF':>7} {'sim CPU/s':>10}")
-        cases = [
-            ("no sensors fitted", (), False),
-            ("sensors fitted, none read", (), True),
-            ("planar lidar, IMU, GNSS read", LIGHT, True),
-            ("every sensor read", "all", True),
-        ]
-        results = {}
-        for label, subscribe, fitted in cases:
-            [(rtf, cpu, _)] = node_case(n, args.seconds, port, [subscribe], sensors=fitted)
-            results[label] = (rtf, cpu)
-            print(f"{label:>36} {rtf:>6.2f}x {cpu:>9.3f}s", flush=True)
-        bare, idle = results["no sensors fitted"][1], results["sensors fitted, none read"][1]
-        per_sensor_idle = (idle - bare) / (6 * n) / bare
-        light = results["planar lidar, IMU, GNSS read"][0]
-        v1, v2 = light >= TARGET_RTF, per_sensor_idle < TARGET_IDLE
-        ok &= v1 and v2
-        print(f"target: lidar, IMU and GNSS read on {n} robots at least {TARGET_RTF:g} x real time: "
-              f"{'met' if v1 else 'MISSED'} ({light:.2f} x)")  # fmt: skip
-        print(f"target: an unread sensor under {TARGET_IDLE:.0%} of the simulator's CPU: "
-              f"{'met' if v2 else 'MISSED'} ({per_sensor_idle:+.2%} each, {6 * n} sensors)")  # fmt: skip
+        if args.part in (None, 1):
+            ok &= sensors_part(args.seconds, port)
+        if args.part in (None, 2):
+            for stack in ("per-robot", "fleet") if args.stack == "both" else (args.stack,):
+                ok &= robots_part(args.robots, args.seconds, port, stack)
     finally:
         import rospy  # noqa: PLC0415
 

@@ -199,14 +199,24 @@ def node(n: int, seconds: float, port: int, clock_rate: float):
             os.unlink(output.name)  # kept when the case failed
 
 
-def fleet_launch(positions, simulator_args: str = "", robot_args: str = ""):
+def fleet_launch(positions, simulator_args: str = "", robot_args: str = "", fleet_driver: bool = False):
     """A launch file (closed, for the caller to remove): simulator.launch as fast as it can, and
-    robot.launch r0, r1, ... at positions [(x, y)], each with robot_args (launch XML) added."""
+    robot.launch r0, r1, ... at positions [(x, y)], each with robot_args (launch XML) added; with
+    fleet_driver, one fleet_driver process does every robot's base_driver, twist_mux and
+    robot_state_publisher work."""
+    if fleet_driver:
+        robot_args += '<arg name="fleet_driver" value="true"/>'
     robots = "\n".join(
         f'  <include file="$(find thorvald_sim)/launch/robot.launch"><arg name="robot_name" value="r{k}"/>'
         f'<arg name="x" value="{x}"/><arg name="y" value="{y}"/>{robot_args}</include>'
         for k, (x, y) in enumerate(positions)
     )
+    if fleet_driver:
+        names = " ".join(f"r{k}" for k in range(len(positions)))
+        robots += (
+            '\n  <include file="$(find thorvald_bringup)/launch/fleet_driver.launch">'
+            f'<arg name="robots" value="{names}"/></include>'
+        )
     launch = tempfile.NamedTemporaryFile("w", suffix=".launch", delete=False)
     launch.write(
         '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'

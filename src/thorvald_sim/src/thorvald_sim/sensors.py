@@ -14,7 +14,7 @@ the sensor has subscribers) and starts again from the instant it is read again.
 * Lidars cast one ray per beam with ``rayTestBatch`` from ``range_min`` to ``range_max`` along the
   beam (as Gazebo's ray sensor, whose rays start at the minimum range), so they see the world, the
   other robots and the robot's own body beyond range_min; no hit is ``inf``. Gaussian noise on
-  every hit.
+  every beam (one without a return stays ``inf``).
 * The IMU reads the mount's orientation in the world (its ``rpyOffset`` applied), its angular
   velocity and its proper acceleration (the mean acceleration since the last reading, minus
   gravity: +9.81 m/s^2 up at rest), in the sensor's axes; gaussianNoise on every component.
@@ -209,11 +209,10 @@ class Lidar(Sensor):
             fractions[k : k + len(hits)] = np.fromiter(map(_FRACTION, hits), float, len(hits))
         fractions[fractions >= 1.0] = np.inf
         ranges = c.range_min + fractions * (c.range_max - c.range_min)
-        if c.noise_stddev > 0 or c.noise_mean != 0:
-            hit = np.isfinite(ranges)
-            ranges[hit] += (
-                self.rng.normal(c.noise_mean, c.noise_stddev, int(hit.sum())) if c.noise_stddev > 0 else c.noise_mean
-            )
+        if c.noise_stddev > 0:  # every beam drawn (inf stays inf): the same draws whatever the beams hit
+            ranges += self.rng.normal(c.noise_mean, c.noise_stddev, ranges.shape)
+        elif c.noise_mean != 0:
+            ranges += c.noise_mean
         return Scan(ranges.reshape(self.directions.shape[:2]), self.directions)
 
 

@@ -128,6 +128,42 @@ def test_a_lidar_reads_the_geometry(world):
     assert np.std(face - true) == pytest.approx(0.01, rel=0.3)
 
 
+TURRET = f"""<robot name="turret">
+  <link name="base_link"><inertial><origin xyz="0.15 -0.1 0.05" rpy="0 0 0.3"/><mass value="20"/>
+    <inertia ixx="0.5" iyy="0.5" izz="0.5" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="0 0 0.1"/><geometry><box size="0.4 0.4 0.2"/></geometry></collision></link>
+  <link name="turret"><inertial><origin xyz="0.05 0.05 0.02" rpy="0.1 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="lidar_link">{INERTIAL.format(m=0.2)}</link>
+  <joint name="turret_joint" type="revolute"><origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="100" velocity="1"/><parent link="base_link"/><child link="turret"/></joint>
+  <joint name="lidar_joint" type="fixed"><origin xyz="0 0 0.5"/>
+    <parent link="turret"/><child link="lidar_link"/></joint>
+  {LIDAR.format(stddev=0.0)}
+</robot>"""
+
+
+def test_a_lidar_on_a_moving_link_turns_with_it(world):
+    # the lidar 1 m up on a turret turned to +90 degrees; both links' centres of mass off their
+    # frames (pybullet casts the beams in a link's centre-of-mass frame): its straight-ahead beam
+    # looks along world +y at a box face 3 m away, and along world +x it sees nothing
+    sim = Simulation(world, parse_world({}))
+    robot = sim.spawn("turret", TURRET, Pose2D())
+    joint = robot.joint_index["turret_joint"]
+    p.setJointMotorControl2(robot.body, joint, p.POSITION_CONTROL, targetPosition=math.pi / 2, force=500,
+                            physicsClientId=world)  # fmt: skip
+    for _ in range(480):
+        sim.step()
+    assert p.getJointState(robot.body, joint, physicsClientId=world)[0] == pytest.approx(math.pi / 2, abs=1e-3)
+    box(world, (1.0, 0.5, 1.5), (0.0, 3.5, 1.5))
+    (lidar,) = robot.sensors
+    c = lidar.spec.config
+    ranges = lidar.read(sim.time).ranges[0]
+    ahead = round((0.0 - c.min_angle) / c.angle_increment)
+    assert ranges[ahead] == pytest.approx(3.0, abs=0.01)
+    assert np.isinf(ranges[round((math.radians(-90) - c.min_angle) / c.angle_increment)])  # world +x: nothing
+
+
 def test_a_multilayer_lidar_ring_hits_a_wall_at_the_height_its_angle_gives(world):
     sim, robot = simulation(world, LAYERS)
     box(world, (0.1, 5.0, 3.0), (5.1, 0.0, 3.0))  # a wall whose face is 5 m ahead
