@@ -44,7 +44,7 @@ import threading
 import time
 
 from base_driver import Processes, cpu_seconds, free_port, start_master
-from sim import children, cmdline, stop_launch
+from sim import children, cmdline, end_launch
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 STD = os.path.join(ROOT, "src", "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
@@ -222,11 +222,7 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master_pid: int, rt
         stop.set()
         for endpoint in subs + odometry + pubs + scans:
             endpoint.unregister()
-        stop_launch(proc)
-        os.unlink(launch.name)
-        output.close()
-        if ok:
-            os.unlink(output.name)  # kept when the case failed
+        end_launch(proc, launch, output, keep_log=not ok)
 
 
 def print_row(n, lidar, stack, r):

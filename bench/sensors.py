@@ -40,7 +40,7 @@ from typing import Optional
 
 import numpy as np
 from base_driver import Processes, cpu_seconds, free_port, start_master
-from sim import children, cmdline, fleet_launch, stop_launch
+from sim import children, cmdline, end_launch, fleet_launch
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 STD = os.path.join(ROOT, "src", "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
@@ -226,9 +226,7 @@ def node_case(
             r.unregister()
         sub.unregister()
         diagnostics.unregister()
-        stop_launch(proc)
-        os.unlink(launch.name)
-        output.close()
+        end_launch(proc, launch, output, keep_log=True)
 
 
 def _sensor_topic(topic: str) -> bool:

@@ -192,11 +192,7 @@ def node(n: int, seconds: float, port: int, clock_rate: float):
         diagnostics.unregister()
         for pub in pubs:
             pub.unregister()
-        stop_launch(proc)
-        os.unlink(launch.name)
-        output.close()
-        if measured:
-            os.unlink(output.name)  # kept when the case failed
+        end_launch(proc, launch, output, keep_log=not measured)
 
 
 def fleet_launch(positions, simulator_args: str = "", robot_args: str = "", fleet_driver: bool = False):
@@ -225,6 +221,16 @@ def fleet_launch(positions, simulator_args: str = "", robot_args: str = "", flee
     )
     launch.close()
     return launch
+
+
+def end_launch(proc, launch, output, keep_log: bool) -> None:
+    """A case's launch stopped, its launch file removed, and its log closed (and removed unless kept:
+    the log of a case that failed)."""
+    stop_launch(proc)
+    os.unlink(launch.name)
+    output.close()
+    if not keep_log:
+        os.unlink(output.name)
 
 
 def stop_launch(proc) -> None:

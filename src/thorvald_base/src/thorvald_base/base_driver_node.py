@@ -79,7 +79,6 @@ from .node_names import Names, Throttle
 from .params import PARAMETER_NAMES, DriverParams
 from .plugins import load_calculator
 
-WARN_PERIOD = 5.0  # [s] between repeats of one warning
 STATUS_PERIOD = 1.0  # [s] between battery_data / motor_controller_data messages
 EXIT_REFUSED = 1  # exit status when the node refuses to start
 
@@ -143,7 +142,7 @@ class BaseDriverNode:
         to share (a fleet_driver's), else the node makes its own when it broadcasts odom."""
         self.names = names = names or Names()
         # log lines name the robot when several share a process
-        self.label = "base_driver" if names.private == "~" else names.node
+        self.label = names.label("base_driver")
         self.throttle = Throttle()
         raw = rospy.get_param(names.param(), {})
         self.params = params = DriverParams.from_dict(raw)

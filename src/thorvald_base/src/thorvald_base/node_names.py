@@ -10,6 +10,8 @@ import time
 
 import rospy
 
+WARN_PERIOD = 5.0  # [s] between repeats of one warning
+
 
 class Names:
     """Where one robot's driver finds its names: a process of its own (the default: rospy's relative
@@ -39,12 +41,17 @@ class Names:
         """The node's resolved name, as log lines and /diagnostics name it."""
         return rospy.get_name() if self.private == "~" else self.private.rstrip("/")
 
+    def label(self, own: str) -> str:
+        """What the node's log lines start with: own (its plain name) in a process of its own, the
+        robot's node name in a fleet_driver process (which robot says it)."""
+        return own if self.private == "~" else self.node
+
 
 class Throttle:
     """rospy.logwarn_throttle kept per object: rospy's is kept per line of code, so in a fleet_driver
     one robot's warning would silence the same warning of every other robot."""
 
-    def __init__(self, period: float = 5.0):
+    def __init__(self, period: float = WARN_PERIOD):
         self.period = period
         self.last = {}
 

@@ -40,7 +40,7 @@ class TwistMuxNode:
         # the topics as subscribed, remappings applied (a launch file may remap nav_vel)
         rospy.loginfo(
             "%s: inputs %s; locks %s",
-            "twist_mux" if names.private == "~" else names.node,
+            names.label("twist_mux"),
             ", ".join(f"{s.name} ({sub.resolved_name}, priority {s.priority})" for s, sub in zip(inputs, self.subs)),
             ", ".join(
                 f"{s.name} ({sub.resolved_name}, priority {s.priority})"

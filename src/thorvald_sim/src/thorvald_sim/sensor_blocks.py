@@ -38,6 +38,7 @@ from dataclasses import dataclass, replace
 from typing import Dict, List, Optional, Tuple
 
 from thorvald_model.datum import Datum
+from thorvald_model.joint_tree import Origin as Pose  # a transform: SDF's <pose> is URDF's <origin>
 
 Vec3 = Tuple[float, float, float]
 
@@ -67,14 +68,6 @@ HECTOR_DRIFT_FREQUENCY = 1.0 / 3600.0  # [1/s]: SensorModel's default time const
 
 # Image formats of Gazebo's <image><format> and the sensor_msgs encodings they are published in
 IMAGE_FORMATS = {"R8G8B8": ("rgb8", 3), "B8G8R8": ("bgr8", 3), "L8": ("mono8", 1), "RGB_INT8": ("rgb8", 3)}
-
-
-@dataclass(frozen=True)
-class Pose:
-    """A transform [m, rad]: translation, then roll, pitch, yaw (fixed axes), as SDF's <pose> and URDF's <origin>."""
-
-    xyz: Vec3 = (0.0, 0.0, 0.0)
-    rpy: Vec3 = (0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
