@@ -166,6 +166,19 @@ def pose_odometry_msg(
     return msg
 
 
+def transform_msg(stamp, parent: str, child: str, transform) -> TransformStamped:
+    """parent -> child as a TransformStamped; transform: ((x, y, z), (qx, qy, qz, qw))."""
+    (x, y, z), (qx, qy, qz, qw) = transform
+    t = TransformStamped()
+    t.header.stamp = stamp
+    t.header.frame_id = parent
+    t.child_frame_id = child
+    t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = x, y, z
+    r = t.transform.rotation
+    r.x, r.y, r.z, r.w = qx, qy, qz, qw
+    return t
+
+
 def odometry_transform(msg: Odometry) -> TransformStamped:
     """The transform header.frame_id -> child_frame_id an Odometry message describes."""
     tf = TransformStamped()

@@ -21,19 +21,8 @@ from tf2_msgs.msg import TFMessage
 
 from thorvald_model.joint_tree import JointTree, UrdfError, joint_positions
 
+from .conversions import transform_msg
 from .errors import ParameterError
-
-
-def transform_msg(stamp, parent: str, child: str, transform) -> TransformStamped:
-    (x, y, z), (qx, qy, qz, qw) = transform
-    t = TransformStamped()
-    t.header.stamp = stamp
-    t.header.frame_id = parent
-    t.child_frame_id = child
-    t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = x, y, z
-    r = t.transform.rotation
-    r.x, r.y, r.z, r.w = qx, qy, qz, qw
-    return t
 
 
 class _Robot:
