@@ -124,6 +124,9 @@ class TeleopTest(unittest.TestCase):
         self.assertIsNotNone(self.teleop.wait_for(twist_is(0, 0, 0), since=released))
         time.sleep(1.0)  # the joystick keeps publishing its (released) state meanwhile
         after = [m for m in self.teleop.since(released)]
+        # turbo commands published before the release may still arrive after it on a busy machine
+        while after and twist_is(*turbo)(after[0]):
+            after.pop(0)
         zeros = [m for m in after if twist_is(0, 0, 0)(m)]
         self.assertEqual(len(zeros), 1, "one zero twist on release")
         self.assertEqual(len(after), 1, "silence after the zero")
@@ -179,7 +182,9 @@ class TeleopTest(unittest.TestCase):
             zero = self.teleop.wait_for(twist_is(0, 0, 0), since=lost, timeout=3.0)
             self.assertIsNotNone(zero, "no stop after the joystick went silent")
             took = time.time() - lost
-            self.assertLess(took, c["joy_timeout"] + 0.5)
+            # joy_timeout after the last joystick message, which came before `lost`; 1 s for delivery
+            # and scheduling on a busy machine (the test's purpose: a stop, not none)
+            self.assertLess(took, c["joy_timeout"] + 1.0)
         finally:
             with self.joy.lock:
                 self.joy.running = True
