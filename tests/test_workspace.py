@@ -1,6 +1,8 @@
 """Workspace-level acceptance tests: the README's commands and the example robots end to end."""
 
 import glob
+import json
+import math
 import os
 import re
 import subprocess
@@ -98,6 +100,69 @@ def test_main_job_records_a_real_bag_of_the_whole_drive_and_writes_figures_8_and
         with open(png, "rb") as f:
             assert f.read(8) == b"\x89PNG\r\n\x1a\n", name
         assert os.path.getsize(png) > 30000 and png in demo, name
+
+
+def test_the_same_seed_in_lockstep_gives_the_same_report_beside_a_busy_core(demo, tmp_path):
+    """Repeatable runs: the main job's field:3 drive (on whatever machine load the suite had) and the
+    same drive again here, beside a core kept busy, read the same figures and record the same ground
+    truth and odometry. In lockstep the simulator starts paused, verification_drive unpauses it once
+    every node is connected, base_driver follows its stamped commands instant by instant, and every
+    sensor's noise is drawn for its instant: the runs are the same to the bit, the millimetre is the
+    issue's bound."""
+    first = os.path.join(WS, "build", "odometry_report_field")
+    burner = subprocess.Popen(["python3", "-c", "while True: pass"])
+    try:
+        proc = run(
+            [
+                "rosrun",
+                "thorvald_bringup",
+                "odometry_report",
+                "--robot",
+                "thorvald_ii_6wd6ws_asym",
+                "--as-built",
+                "field:3",
+                "--out",
+                str(tmp_path),
+                "--json",
+                str(tmp_path / "figures.json"),
+            ],
+            timeout=600,
+        )
+    finally:
+        burner.kill()
+        burner.wait()
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    with open(os.path.join(first, "figures.json")) as f:
+        before = json.load(f)
+    with open(tmp_path / "figures.json") as f:
+        again = json.load(f)
+    assert sorted(before) == sorted(again)
+    for table in ("against_truth", "against_rtk_gnss"):
+        for path, figures in before[table].items():
+            for key, value in figures.items():
+                if value is None:  # the reference's own error
+                    assert again[table][path][key] is None
+                    continue
+                bound = 1e-3 if key.endswith("_m") else 1e-3 * 100 / 80 if key.endswith("percent") else 0.01
+                assert abs(again[table][path][key] - value) <= bound, (table, path, key, value, again[table][path][key])
+    # the recordings themselves: ground truth and odometry at every common instant, within a millimetre
+    for topic in ("odometry/gazebo", "odometry/base_raw"):
+        a, b = poses(os.path.join(first, "odometry_report.bag"), topic), poses(tmp_path / "odometry_report.bag", topic)
+        common = sorted(set(a) & set(b))
+        assert len(common) > 4000, topic  # 90 s at 50 Hz
+        worst = max(math.hypot(a[t][0] - b[t][0], a[t][1] - b[t][1]) for t in common)
+        assert worst < 1e-3, (topic, worst)
+
+
+def poses(bag_path, ending):
+    """{stamp [ns]: (x, y)} of the topic of the bag ending in ending."""
+    out = {}
+    with rosbag.Bag(str(bag_path)) as bag:
+        (topic,) = [t for t in bag.get_type_and_topic_info().topics if t.endswith("/" + ending)]
+        for _, msg, _ in bag.read_messages(topics=[topic]):
+            p = msg.pose.pose.position
+            out[msg.header.stamp.to_nsec()] = (p.x, p.y)
+    return out
 
 
 def test_verification_drive_on_base_drivers_own_simulated_drives():

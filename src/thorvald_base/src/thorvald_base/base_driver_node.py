@@ -34,12 +34,21 @@ Private parameters besides the configuration:
                                    ``~lockstep``: the loop runs on the arrival of drive states
                                    instead of the clock, a cycle at the first instant ~rate asks
                                    for, and answers every other instant with the last commands, so
-                                   the simulator steps only when base_driver has (default false)
+                                   the simulator steps only when base_driver has (default false);
+                                   it then also follows ``cmd_vel_stamped`` (below)
 ``~can_interface_type/name``       the CAN line of a real base: a python-can interface
                                    (``socketcan``, ``slcan``, ``virtual``, ``pcan``, ...) and channel
 ``~can_bitrate``                   for interfaces that set it (default 1000000)
 ``~allow_relay_to_base_devices``   relay frames addressed to the base's own devices (default false)
 =================================  ===========================================================
+
+In lockstep, base_driver also subscribes ``cmd_vel_stamped`` (geometry_msgs/TwistStamped): the
+commands of a source that publishes each before the instant in its stamp (verification_drive).
+Once one comes, each cycle at instant t waits until a command stamped after t has come, applies
+the last one stamped at or before t, and ignores ``cmd_vel``: what each cycle commands is then the
+same in every run, however loaded the machine (see :mod:`thorvald_base.stamped_commands`). A
+source that stops publishing (its node left, or nothing for ``STAMPED_WAIT`` s of wall time) is
+let go with a warning, and ``cmd_vel`` rules again.
 
 A bad configuration, calibration file or parameter stops the node at start with a fatal log naming
 it (the file, the key path, the value and the rule), exit status 1.
@@ -48,11 +57,12 @@ it (the file, the key path, the value and the rule), exit status 1.
 import math
 import sys
 import threading
+import time
 
 import rospy
 import tf2_ros
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import Twist
+from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import BatteryState, JointState
 from std_srvs.srv import SetBool, SetBoolResponse, Trigger, TriggerResponse
@@ -78,9 +88,11 @@ from .errors import ParameterError, ThorvaldBaseError
 from .node_names import Names, Throttle
 from .params import PARAMETER_NAMES, DriverParams
 from .plugins import load_calculator
+from .stamped_commands import StampedCommands
 
 STATUS_PERIOD = 1.0  # [s] between battery_data / motor_controller_data messages
 EXIT_REFUSED = 1  # exit status when the node refuses to start
+STAMPED_WAIT = 2.0  # [s] of wall time a lockstep cycle waits for its stamped command before letting the source go
 
 
 def load_config(raw: dict, params: DriverParams, names: Names = None):
@@ -195,6 +207,13 @@ class BaseDriverNode:
         if params.passthrough_gazebo_odometry:
             rospy.Subscriber(names.topic("odometry/gazebo"), Odometry, self.on_gazebo_odometry, queue_size=10)
         rospy.Subscriber(names.topic("cmd_vel"), Twist, self.on_cmd_vel, queue_size=1)
+        self.stamped = StampedCommands()
+        self.stamped_arrived = threading.Condition()  # guards self.stamped
+        self.stamped_sub = None
+        if self.lockstep:
+            self.stamped_sub = rospy.Subscriber(
+                names.topic("cmd_vel_stamped"), TwistStamped, self.on_cmd_vel_stamped, queue_size=1000
+            )
         rospy.Service(names.param("home_steering"), Trigger, self.srv_home_steering)
         rospy.Service(names.param("reset_base_odom"), Trigger, self.srv_reset_odom)
         rospy.Service(names.param("safety_stop"), SetBool, self.srv_safety_stop)
@@ -239,10 +258,42 @@ class BaseDriverNode:
 
     # ---- callbacks: message -> core -> message -----------------------------------------------
     def on_cmd_vel(self, msg):
+        with self.stamped_arrived:
+            if self.stamped.active:  # following a stamped stream (lockstep)
+                return
         with self.lock:
             refused = self.core.set_command(msg.linear.x, msg.linear.y, msg.angular.z, rospy.get_time())
         if refused:
             self.throttle.warn(self.label + ": %s", refused)
+
+    def on_cmd_vel_stamped(self, msg):
+        t = msg.twist
+        with self.stamped_arrived:
+            if not self.stamped.active:
+                rospy.loginfo(self.label + ": following the stamped commands of cmd_vel_stamped (lockstep)")
+            self.stamped.add(msg.header.stamp.to_sec(), (t.linear.x, t.linear.y, t.angular.z))
+            self.stamped_arrived.notify_all()
+
+    def stamped_command(self, t):
+        """Lockstep: the stamped command holding at t, once it is certain (a command stamped after t
+        came), or None when no stamped stream holds at t (or its source was let go)."""
+        deadline = None
+        with self.stamped_arrived:
+            if not self.stamped.begun(t):
+                return None
+            while not self.stamped.known(t):
+                now = time.monotonic()
+                deadline = deadline or now + STAMPED_WAIT
+                if now > deadline or not self.stamped_sub.get_num_connections() or rospy.is_shutdown():
+                    self.stamped.clear()
+                    rospy.logwarn(
+                        self.label + ": cmd_vel_stamped: no command stamped after %.3f s came (%s): following cmd_vel",
+                        t,
+                        "its source left" if now <= deadline else f"waited {STAMPED_WAIT:g} s",
+                    )
+                    return None
+                self.stamped_arrived.wait(0.01)
+            return self.stamped.at(t)
 
     def on_gazebo_odometry(self, msg):
         if self.gazebo_odom is None:
@@ -350,12 +401,16 @@ class BaseDriverNode:
             if t >= next_cycle - 1e-9:
                 next_cycle = (math.floor(t / period + 1e-9) + 1) * period
                 stamp = rospy.Time.from_sec(t)
+                twist = self.stamped_command(t)
                 with self.lock:
                     if self.core.closed:
                         break
+                    refused = self.core.set_command(*twist, t) if twist is not None else None
                     result = self.core.step(t)
                     if result.odometry.valid:
                         self.covariance.update(result.odometry)
+                if refused:
+                    self.throttle.warn(self.label + ": cmd_vel_stamped: %s", refused)
                 self.publish(result, stamp)
             else:
                 with self.lock:

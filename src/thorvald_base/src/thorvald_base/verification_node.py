@@ -1,7 +1,11 @@
 """The ``verification_drive`` node: drives the paper's verification manoeuvre on simulated time.
 
 It publishes the planned twists on ``cmd_vel`` (remap it to an input of twist_mux, e.g.
-``nav_vel``), records ``odometry/base_raw`` and prints the report. Run it with ``/use_sim_time``
+``nav_vel``) and, stamped with the instant each holds from and published ahead of it, on
+``cmd_vel_stamped`` (geometry_msgs/TwistStamped: what base_driver in lockstep follows, so a
+lockstep run commands the same at every instant whatever the machine's load), records
+``odometry/base_raw`` and prints the report. The manoeuvre starts on a whole second of simulated
+time (``~settle`` or more after the robot is ready), on the commands' grid. Run it with ``/use_sim_time``
 true. With ``~own_clock`` true (the default, for base_driver's own simulated drives) it owns the
 simulated clock: it publishes ``/clock`` ``~speedup`` times faster than real time. With
 ``~own_clock`` false it follows the clock of a simulator (thorvald_sim), which sets the pace.
@@ -9,15 +13,21 @@ simulated clock: it publishes ``/clock`` ``~speedup`` times faster than real tim
 Parameters: ``~robot_model`` (the robot's YAML, for the plan and the report), ``~own_clock``
 (default true), ``~speedup`` (default 5), ``~clock_step`` [s] of simulated time per /clock message
 (default 0.005), ``~command_rate`` [Hz] (default 20), ``~startup_timeout`` [s] of wall time
-(default 30), ``~command_subscribers`` (default 1: twist_mux), ``~ready_topic`` (an Odometry
+(default 30), ``~command_subscribers`` (default 1: twist_mux), ``~stamped_subscribers`` (of
+``cmd_vel_stamped``, default 0; 1 for a base_driver in lockstep), ``~ready_topic`` (an Odometry
 topic that must publish before the drive starts, e.g. ``odometry/gazebo``: the robot is in the
 simulator; default none), ``~settle`` [s] of simulated time standing still before and after the
 manoeuvre (default 1), ``~recorder`` and ``~recorded_topics`` (a ``rosbag record`` node and the
 topics it records, a list or a space-separated string: the drive starts only when every
 publisher of each of them has a connection to the recorder, as ``rosnode info`` shows; default
-none).
+none), ``~connections`` (more such waits: a list of ``"NODE TOPIC"``, e.g. ``"base_driver
+drive_states"``: every publisher of TOPIC connected to NODE; default none), ``~unpause`` (the
+service that unpauses a simulator started paused, e.g. ``/simulator/unpause``: the drive waits
+for its connections alone, as nothing moves yet, publishes its first stamped commands and
+unpauses, so the run is the same from its first instant; default none).
 """
 
+import math
 import os
 import sys
 import time
@@ -26,8 +36,10 @@ import xmlrpc.client
 import rosgraph
 import rospy
 from geometry_msgs.msg import Twist as TwistMsg
+from geometry_msgs.msg import TwistStamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
+from std_srvs.srv import Empty
 
 from thorvald_model import ConfigError, load_robot_config
 
@@ -47,12 +59,18 @@ class VerificationDrive:
         self.startup_timeout = float(rospy.get_param("~startup_timeout", 30.0))
         self.own_clock = bool(rospy.get_param("~own_clock", True))
         self.command_subscribers = int(rospy.get_param("~command_subscribers", 1))
+        self.stamped_subscribers = int(rospy.get_param("~stamped_subscribers", 0))
         self.settle = float(rospy.get_param("~settle", 1.0))
         recorder = str(rospy.get_param("~recorder", ""))
         self.recorder = rospy.resolve_name(recorder) if recorder else ""
         topics = rospy.get_param("~recorded_topics", [])
         self.recorded = [rospy.resolve_name(t) for t in (topics.split() if isinstance(topics, str) else topics)]
-        self.unrecorded = list(self.recorded) if self.recorder else []
+        self.unconnected = [(self.recorder, t) for t in self.recorded] if self.recorder else []
+        for pair in rospy.get_param("~connections", []):
+            node, topic = str(pair).split()
+            self.unconnected.append((rospy.resolve_name(node), rospy.resolve_name(topic)))
+        unpause = str(rospy.get_param("~unpause", "") or "")
+        self.unpause = rospy.resolve_name(unpause) if unpause else ""
         self.recorder_checked = 0.0  # [s] wall
         ready_topic = str(rospy.get_param("~ready_topic", ""))
         self.ready = not ready_topic
@@ -61,6 +79,7 @@ class VerificationDrive:
         self.description, self.plan = plan_for(self.config)
         self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10) if self.own_clock else None
         self.cmd_pub = rospy.Publisher("cmd_vel", TwistMsg, queue_size=10)
+        self.stamped_pub = rospy.Publisher("cmd_vel_stamped", TwistStamped, queue_size=100)
         self.points = []
         self.recording = False
         self.odom_seen = False
@@ -71,19 +90,20 @@ class VerificationDrive:
         self.odom_seen = True
         if self.recording:
             p = msg.pose.pose.position
-            self.points.append((p.x, p.y))
+            self.points.append((msg.header.stamp.to_sec(), p.x, p.y))
 
     def on_ready(self, _msg):
         self.ready = True
 
-    def recording_all(self) -> bool:
-        """Whether the recorder has a connection from every publisher of every recorded topic (asked
-        at most every RECORDER_POLL s of wall time: one XML-RPC call per publisher)."""
-        if not self.unrecorded or time.time() - self.recorder_checked < RECORDER_POLL:
-            return not self.unrecorded
+    def connected_all(self) -> bool:
+        """Whether every awaited node (the recorder, ~connections) has a connection from every
+        publisher of its topic (asked at most every RECORDER_POLL s of wall time: one XML-RPC call
+        per publisher)."""
+        if not self.unconnected or time.time() - self.recorder_checked < RECORDER_POLL:
+            return not self.unconnected
         self.recorder_checked = time.time()
-        self.unrecorded = [t for t in self.unrecorded if not connected_to(self.recorder, t)]
-        return not self.unrecorded
+        self.unconnected = [(node, t) for node, t in self.unconnected if not connected_to(node, t)]
+        return not self.unconnected
 
     def tick(self):
         if self.own_clock:
@@ -96,66 +116,108 @@ class VerificationDrive:
         rospy.sleep(self.sim_time + self.step - rospy.get_time())
         self.sim_time = rospy.get_time()
 
-    def settle_for(self, seconds):
-        end = self.sim_time + seconds
-        while self.sim_time < end and not rospy.is_shutdown():
-            self.tick()
-
     def run(self):
-        # Let time run until base_driver publishes odometry and twist_mux listens to our commands.
+        # Let time run until base_driver publishes odometry and twist_mux listens to our commands (or,
+        # with a paused simulator to unpause, until every connection is there: nothing publishes yet).
         deadline = time.time() + self.startup_timeout
-        if not self.own_clock:
+        paused = bool(self.unpause)
+        if not self.own_clock and not paused:
             while rospy.get_time() == 0.0:
                 if time.time() > deadline or rospy.is_shutdown():
                     raise RuntimeError("no /clock: the simulator did not come up")
                 time.sleep(0.01)
             self.sim_time = rospy.get_time()
+        elif paused:
+            self.sim_time = rospy.get_time()
         while not (
-            self.ready
-            and self.odom_seen
+            (paused or (self.ready and self.odom_seen))
             and self.cmd_pub.get_num_connections() >= self.command_subscribers
-            and self.recording_all()
+            and self.stamped_pub.get_num_connections() >= self.stamped_subscribers
+            and self.connected_all()
         ):
             if time.time() > deadline or rospy.is_shutdown():
                 raise RuntimeError(
                     "the robot did not come up: odometry/base_raw {}, ready topic {}, {} of {} subscribers of the "
-                    "commands{}".format(
+                    "commands, {} of {} of the stamped commands{}".format(
                         "heard" if self.odom_seen else "silent",
                         "heard" if self.ready else "silent",
                         self.cmd_pub.get_num_connections(),
                         self.command_subscribers,
-                        f", {self.recorder} not connected to {' '.join(self.unrecorded)}" if self.unrecorded else "",
+                        self.stamped_pub.get_num_connections(),
+                        self.stamped_subscribers,
+                        "".join(f", {node} not connected to {topic}" for node, topic in self.unconnected),
                     )
                 )
-            self.tick()
-        self.settle_for(self.settle)  # standing still
+            if paused:
+                time.sleep(0.01)
+            else:
+                self.tick()
+        # the manoeuvre from the first whole second settle after now: its instants (and those of the
+        # commands, multiples of the command period) are the same in every run
+        start = float(math.ceil(self.sim_time + self.settle - 1e-9))
+        total = duration(self.plan)
+        stop = start + total + self.settle  # the robot has come to rest
+        period = self.command_period
+        stamped = math.ceil(self.sim_time / period - 1e-9)  # index of the next stamped command
+        plain = None  # index of the last plain command
         self.points = []
         self.recording = True
-        start_sim, start_wall = self.sim_time, time.time()
-        next_command = start_sim
-        total = duration(self.plan)
-        while not rospy.is_shutdown():
-            t = self.sim_time - start_sim
-            twist = twist_at(self.plan, t)
-            if twist is None:
-                break
-            if self.sim_time >= next_command:
-                msg = TwistMsg()
-                msg.linear.x, msg.linear.y, msg.angular.z = twist.vx, twist.vy, twist.wz
-                self.cmd_pub.publish(msg)
-                next_command += self.command_period
+        start_wall = None
+        first = True
+        while self.sim_time < stop and not rospy.is_shutdown():
+            if start_wall is None and self.sim_time >= start:
+                start_wall = time.time()
+            # ahead of its instant by a period and a step: base_driver in lockstep, waiting at an
+            # instant before our next wake-up, already holds a command stamped after it
+            while stamped * period <= self.sim_time + period + self.step:
+                self.stamped_pub.publish(stamped_msg(stamped * period, self.twist_for(stamped * period - start)))
+                stamped += 1
+            if first and paused:
+                time.sleep(0.1)  # the first stamped commands on their way to base_driver before the world moves
+                self.unpause_simulator()
+            first = False
+            k = math.floor(self.sim_time / period + 1e-9)
+            if k != plain:
+                plain = k
+                self.cmd_pub.publish(twist_msg(self.twist_for(k * period - start)))
             self.tick()
-        self.settle_for(self.settle)  # let the robot come to rest
         self.recording = False
+        points = [(x, y) for t, x, y in self.points if start - 1e-6 <= t <= stop + 1e-6]
         return report(
             self.name,
             self.config,
             self.description,
             self.plan,
-            self.points,
+            points,
             sim_time=total,
-            wall=time.time() - start_wall,
+            wall=time.time() - (start_wall or time.time()),
         )
+
+    def unpause_simulator(self):
+        try:
+            rospy.wait_for_service(self.unpause, timeout=self.startup_timeout)
+            rospy.ServiceProxy(self.unpause, Empty)()
+        except (rospy.ROSException, rospy.ServiceException) as e:
+            raise RuntimeError(f"~unpause: {self.unpause}: {e}") from None
+        rospy.loginfo("verification_drive: %s called: the drive runs from %.3f s", self.unpause, self.sim_time)
+
+    def twist_for(self, t):
+        """The plan's twist at t [s] from its start; standing still before and after it."""
+        twist = twist_at(self.plan, t) if t >= 0 else None
+        return (twist.vx, twist.vy, twist.wz) if twist is not None else (0.0, 0.0, 0.0)
+
+
+def twist_msg(twist):
+    msg = TwistMsg()
+    msg.linear.x, msg.linear.y, msg.angular.z = twist
+    return msg
+
+
+def stamped_msg(t, twist):
+    msg = TwistStamped()
+    msg.header.stamp = rospy.Time.from_sec(t)
+    msg.twist = twist_msg(twist)
+    return msg
 
 
 def connected_to(subscriber: str, topic: str) -> bool:

@@ -230,3 +230,20 @@ def test_simulated_joints_send_commands_and_read_the_measured_states():
         base.update(measured[:3], 11.0)
     base.close(11.0)
     assert sent[-1] == (11.0, tuple([DriveCommand(0.0, 0.0)] * 4))  # the stop before closing
+
+
+def test_simulated_joints_give_a_cycle_the_states_of_its_instant_not_newer_ones():
+    # in lockstep the simulator steps on once the cycle's commands reach it: the next instant's states
+    # may arrive before the cycle reads them again, and must not be read as the cycle's
+    from thorvald_base.bases.simulated_joints import SimulatedJointsBase  # noqa: PLC0415
+
+    base = SimulatedJointsBase(four_ws(), lambda commands, time: None, stale_after=0.5)
+    at = {t: [MeasuredDrive(0.0, t, t, 0.0)] * 4 for t in (1.0, 1.01, 1.02)}
+    base.update(at[1.0], 1.0)
+    base.update(at[1.01], 1.01)
+    assert base.read_drive_states(1.0) == at[1.0]
+    assert base.read_drive_states(1.015) == at[1.01]  # the newest at or before the instant
+    base.update(at[1.02], 1.02)
+    assert base.read_drive_states(1.05) == at[1.02]
+    base.update(at[1.0], 0.5)  # simulated time went back: the newest is all there is
+    assert base.read_drive_states(0.5) == at[1.0]

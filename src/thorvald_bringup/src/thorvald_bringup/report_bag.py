@@ -1,8 +1,9 @@
 """Reads a drive recorded by odometry_report.launch (or any bag with the same topics) into a Recording.
 
 Topics are found by their ending, so a robot in any namespace works: ``.../odometry/gazebo``,
-``.../odometry/base_raw``, ``.../base_state``, and the commands ``.../twist_mux/cmd_vel`` (what
-base_driver got) or else ``.../nav_vel`` (what was sent); and, when recorded, RTK-GNSS
+``.../odometry/base_raw``, ``.../base_state``, and the commands: ``.../cmd_vel_stamped`` (each at
+the instant in its stamp: the same in every run), else ``.../twist_mux/cmd_vel`` (what base_driver
+got, when rosbag received it) or ``.../nav_vel`` (what was sent); and, when recorded, RTK-GNSS
 ``.../gps/fix`` with the IMU's ``.../imu/data`` (the antenna over base_link, the reference heading
 0). Messages are decoded with the definitions stored in the bag, so a bag from another machine
 reads without its message packages.
@@ -21,6 +22,7 @@ ENDINGS = {
     "truth": "odometry/gazebo",
     "odometry": "odometry/base_raw",
     "states": "base_state",
+    "stamped": "cmd_vel_stamped",
     "commands": "twist_mux/cmd_vel",
     "sent": "nav_vel",
 }
@@ -39,11 +41,11 @@ def read_recording(path: str, robot: str = "") -> Recording:
     with bag:
         topics, names = _topics(bag, path)
         missing = [ENDINGS[k] for k in ("truth", "odometry", "states") if k not in topics]
-        if "commands" not in topics and "sent" not in topics:
-            missing.append(f"{ENDINGS['commands']} or {ENDINGS['sent']}")
+        if not any(k in topics for k in ("stamped", "commands", "sent")):
+            missing.append(f"{ENDINGS['stamped']}, {ENDINGS['commands']} or {ENDINGS['sent']}")
         if missing:
             raise ReportError(f"{path}: no topic ending in {', '.join(missing)} (the bag has: {', '.join(names)})")
-        command_topic = topics.get("commands", topics.get("sent"))
+        command_topic = topics.get("stamped", topics.get("commands", topics.get("sent")))
         rec = Recording([], Path(), Path(), [], robot=robot, source=path)
         wanted = [topics["truth"], topics["odometry"], topics["states"], command_topic]
         wanted += [topics[k] for k in ("fix", "imu") if k in topics]
@@ -55,6 +57,8 @@ def read_recording(path: str, robot: str = "") -> Recording:
             elif topic == topics.get("imu"):
                 yaws.append((msg.header.stamp.to_sec(), quaternion_yaw(msg.orientation)))
             elif topic == command_topic:
+                if hasattr(msg, "header"):  # stamped: the instant it holds from, published ahead of it
+                    stamp, msg = msg.header.stamp, msg.twist
                 rec.commands.append((stamp.to_sec(), msg.linear.x, msg.linear.y, msg.angular.z))
             elif topic == topics["states"]:
                 rec.states.append((msg.header.stamp.to_sec(), tuple(msg.steer_pos), tuple(msg.prop_speed)))

@@ -32,10 +32,13 @@ Lockstep (``~lockstep`` true): with measured drives, the simulator publishes eac
 ``drive_states`` with every ``/clock`` tick and steps no further until that robot's base_driver
 (``~lockstep`` true as well) has answered them with a ``drive_commands`` stamped with the same
 instant. The run is then the same on an idle and on a busy machine and at any real-time factor. A
-robot joins with its first command and is let go, with a warning, when it has not answered for
-``LOCKSTEP_TIMEOUT`` seconds of wall time (its driver died or stopped): the others go on, and it
-joins again with its next command. Without lockstep the simulator waits only for robots that lag
-more than ``~max_lag``.
+robot joins with the first drive states it publishes to a reader (so the steps before its first
+answer do not depend on how soon that answer came) and is let go, with a warning, when it has not
+answered for ``LOCKSTEP_TIMEOUT`` seconds of wall time (its driver died or stopped, or it reads
+drive states without being in lockstep): the others go on, and it joins again with its next
+command. A run that must repeat from its first instant starts paused (``~paused``), and whoever
+drives it unpauses once every node is connected (see verification_drive's ``~unpause``). Without
+lockstep the simulator waits only for robots that lag more than ``~max_lag``.
 
 Sensors: the Gazebo sensor blocks of each robot's description (``model_extras``) are simulated
 with the gazebo_ros plugins' topics, frames and parameters (:mod:`thorvald_sim.sensor_blocks`,
@@ -148,7 +151,8 @@ class RobotIO:
         self.command_wall = None  # [s] wall (monotonic) time it arrived
         self.fresh = False
         self.awaiting = None  # [s] lockstep: the instant of drive states not answered yet
-        self.in_lockstep = False  # lockstep: it answers (joined with its first command)
+        self.in_lockstep = False  # lockstep: it answers (joined with its first drive states read, or command)
+        self.joined = False  # lockstep: it was awaited once (a robot let go joins again by a command only)
         self.node = node
         self.sub = rospy.Subscriber(ns + command_topic, BaseState, self.on_command, queue_size=1)
         self.passive = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
@@ -182,7 +186,7 @@ class RobotIO:
         if self.node.lockstep:
             with self.node.answered:
                 if not self.in_lockstep:
-                    self.in_lockstep = True
+                    self.joined = self.in_lockstep = True
                     rospy.loginfo("simulator: %s in lockstep", self.robot.name)
                 if self.awaiting is not None and stamp >= self.awaiting - 1e-9:
                     self.awaiting = None
@@ -237,9 +241,13 @@ class RobotIO:
     def publish_drives(self, stamp):
         if self.drive_pub.get_num_connections():  # base_driver with measured drives
             now = stamp.to_sec()
-            if self.node.lockstep and self.in_lockstep:
+            if self.node.lockstep:
                 with self.node.answered:
-                    self.awaiting = now
+                    if not self.joined:  # its reader is there: from its first drive states on, not its first answer
+                        self.joined = self.in_lockstep = True
+                        rospy.loginfo("simulator: %s in lockstep", self.robot.name)
+                    if self.in_lockstep:
+                        self.awaiting = now
             self.drive_pub.publish(conversions.state_msg(stamp, self.robot.drive_states(now)))
 
     def close(self):

@@ -292,11 +292,34 @@ def test_a_schedule_starts_again_from_when_it_is_read_again():
     assert not schedule.due(5.0 + dt, dt)
 
 
+def test_a_schedules_instants_are_its_periods_multiples_whenever_it_began():
+    # 10 Hz at 240 Hz physics: the readings fall on the steps nearest 0.1, 0.2, ... s (steps 24, 48, ...)
+    # whether the sensor was first read at step 5 or at step 17
+    dt = 1.0 / 240
+    for first in (5, 17):
+        schedule = Schedule(10.0)
+        steps = [k for k in range(first, 100) if schedule.due(k * dt, dt)]
+        assert steps == [24, 48, 72, 96]
+
+
 def test_noise_is_seeded():
-    a = noise_generator(7, "r1", "lidar").normal(size=5)
-    assert np.array_equal(a, noise_generator(7, "r1", "lidar").normal(size=5))
-    assert not np.array_equal(a, noise_generator(8, "r1", "lidar").normal(size=5))
-    assert not np.array_equal(a, noise_generator(7, "r2", "lidar").normal(size=5))
+    a = noise_generator(7, "r1", "lidar").at(3).normal(size=5)
+    assert np.array_equal(a, noise_generator(7, "r1", "lidar").at(3).normal(size=5))
+    assert not np.array_equal(a, noise_generator(8, "r1", "lidar").at(3).normal(size=5))
+    assert not np.array_equal(a, noise_generator(7, "r2", "lidar").at(3).normal(size=5))
+    assert not np.array_equal(a, noise_generator(7, "r1", "lidar").at(4).normal(size=5))
+
+
+def test_an_instants_noise_does_not_depend_on_what_was_drawn_before():
+    # a run whose recorder subscribed later drew less before: the same instant still draws the same
+    late, early = noise_generator(7, "r1", "gps"), noise_generator(7, "r1", "gps")
+    for k in range(50):
+        early.at(k).normal(size=720)
+    assert np.array_equal(late.at(50).normal(size=3), early.at(50).normal(size=3))
+    # and consecutive instants' streams do not overlap: many draws at one instant never reach the next's
+    many = noise_generator(7, "r1", "gps").at(50).standard_normal(100000)
+    following = noise_generator(7, "r1", "gps").at(51).standard_normal(4)
+    assert not any(np.array_equal(following, many[i : i + 4]) for i in range(len(many) - 3))
 
 
 def test_the_same_seed_gives_the_same_scan(world):

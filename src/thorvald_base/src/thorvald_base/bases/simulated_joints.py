@@ -11,6 +11,10 @@ The class is pure: it gets a function that sends commands, and the node's subscr
 measured states (:meth:`update`); :meth:`from_params` wires both to the topics the node offers
 (:class:`~thorvald_base.bases.handle.Ports`), so no ROS module is imported here.
 
+A cycle at instant t reads the newest measurement taken at or before t: in lockstep the simulator
+steps on as soon as the cycle's commands reach it, and the next instant's states may arrive while
+the cycle still reads (base_driver reads once more after sending): they belong to the next cycle.
+
 Homing points every wheel straight with zero speed until base_driver ends it. Measurements older
 than ``stale_after`` [s] mean the simulator lost the robot: the wheels are sent zero speeds and the
 controllers read as lost.
@@ -23,6 +27,7 @@ and a measured one read as v * r_now / r_spawn. Angles (steering, wheel) cross u
 """
 
 import threading
+from collections import deque
 from dataclasses import replace
 from typing import Callable, List, Optional, Sequence, Tuple
 
@@ -32,6 +37,8 @@ from ..modes import MODE_LOST_CONNECTION, MODE_ONLINE
 from .handle import BaseHandle, ControllerInfo, MeasuredDrive
 
 SendCommands = Callable[[Tuple[DriveCommand, ...], float], None]
+HISTORY = 8  # measurements kept: a cycle reads the newest taken at or before its instant
+SAME_INSTANT = 1e-9  # [s]
 
 
 class SimulatedJointsBase(BaseHandle):
@@ -45,6 +52,7 @@ class SimulatedJointsBase(BaseHandle):
         self._lock = threading.Lock()
         self._measured: List[MeasuredDrive] = [MeasuredDrive(0.0, 0.0, 0.0, 0.0) for _ in config.drives]
         self._measured_time: Optional[float] = None
+        self._history = deque(maxlen=HISTORY)  # (time, states) of the last measurements, oldest first
         self._topics = None
         self._arrived = threading.Condition(self._lock)  # lockstep: new drive states
         self._last_sent: Optional[Tuple[DriveCommand, ...]] = None  # what went to the simulator last
@@ -70,8 +78,11 @@ class SimulatedJointsBase(BaseHandle):
         if len(states) != len(self.config.drives):
             raise ValueError(f"{len(states)} drive states for {len(self.config.drives)} drives")
         with self._lock:
+            if self._history and time < self._history[-1][0]:
+                self._history.clear()  # simulated time went back (a reset)
             self._measured = list(states)
             self._measured_time = time
+            self._history.append((time, self._measured))
             self._arrived.notify_all()
 
     def wait_for_states(self, after: Optional[float], timeout: float) -> Optional[float]:
@@ -106,7 +117,12 @@ class SimulatedJointsBase(BaseHandle):
 
     def _read_drive_states(self, time):
         with self._lock:
-            measured = list(self._measured)
+            measured = self._measured  # newest; unless newer than time, then the newest at or before it
+            for t, states in reversed(self._history):
+                if t <= time + SAME_INSTANT:
+                    measured = states
+                    break
+            measured = list(measured)
         return [replace(m, speed=m.speed * k) if k != 1.0 else m for m, k in zip(measured, self._scales)]
 
     def _home_steering(self):
