@@ -8,6 +8,7 @@ resolved as the plugins resolve them (:func:`thorvald_sim.sensor_blocks.resolve_
 """
 
 import math
+import struct
 import time
 from typing import Dict, List, Optional
 
@@ -64,6 +65,41 @@ CAMERA_DTYPE = np.dtype(
 )
 
 
+_HEADER = struct.Struct("<3I")  # seq, stamp secs, nsecs; then frame_id as a length and its bytes
+_LENGTH = struct.Struct("<I")
+_SCAN = struct.Struct("<7f")  # angle_min, angle_max, angle_increment, time_increment, scan_time, range_min, range_max
+
+
+class FastLaserScan(LaserScan):
+    """A LaserScan whose ``ranges`` and ``intensities`` are float32 numpy arrays, serialised with
+    their bytes as they are. genpy packs a float array float by float from a list (a list that must
+    be made first): for 720 beams at 40 Hz, half of what publishing a scan cost beyond its rays. The
+    bytes are genpy's (``test_sensor_io``); readers see a plain sensor_msgs/LaserScan."""
+
+    __slots__ = ()
+
+    def serialize(self, buff):
+        h = self.header
+        frame = h.frame_id.encode()
+        buff.write(_HEADER.pack(h.seq, h.stamp.secs, h.stamp.nsecs))
+        buff.write(_LENGTH.pack(len(frame)))
+        buff.write(frame)
+        buff.write(
+            _SCAN.pack(
+                self.angle_min,
+                self.angle_max,
+                self.angle_increment,
+                self.time_increment,
+                self.scan_time,
+                self.range_min,
+                self.range_max,
+            )
+        )
+        for values in (self.ranges, self.intensities):
+            buff.write(_LENGTH.pack(len(values)))
+            buff.write(np.ascontiguousarray(values, dtype="<f4").tobytes())
+
+
 def search_tf_prefix(namespace: str) -> str:
     """tf::getPrefixParam: the ``tf_prefix`` parameter searched up from the namespace ("" if none)."""
     parts = [p for p in namespace.strip("/").split("/") if p]
@@ -89,6 +125,7 @@ class SensorIO:
         self.cpu = 0.0  # [s] spent measuring and publishing since the last report
         self.readings = 0
         self.active = False
+        self._scan_msg = None  # a planar lidar's LaserScan, reused
 
     def subscribed(self) -> Dict[str, bool]:
         return {role: pub.get_num_connections() > 0 for role, pub in self.pubs.items()}
@@ -122,15 +159,18 @@ class SensorIO:
 
     # ---- kinds ------------------------------------------------------------------------------
     def _laser(self, scan, stamp, wanted):
-        c = self.sensor.spec.config
-        msg = self.header(LaserScan(), stamp)
-        msg.angle_min, msg.angle_max, msg.angle_increment = c.min_angle, c.max_angle, c.angle_increment
-        msg.time_increment = 0.0  # an instantaneous scan, as gazebo_ros's
-        msg.scan_time = 0.0
-        msg.range_min, msg.range_max = c.range_min, c.range_max
+        msg = self._scan_msg
+        if msg is None:  # made once: a scan's fields but its stamp and ranges stay (publish serialises at once)
+            c = self.sensor.spec.config
+            msg = self._scan_msg = self.header(FastLaserScan(), stamp)
+            msg.angle_min, msg.angle_max, msg.angle_increment = c.min_angle, c.max_angle, c.angle_increment
+            msg.time_increment = 0.0  # an instantaneous scan, as gazebo_ros's
+            msg.scan_time = 0.0
+            msg.range_min, msg.range_max = c.range_min, c.range_max
+            msg.intensities = np.zeros(scan.ranges.shape[1], dtype=np.float32)  # gazebo_ros's: one per beam
+        msg.header.stamp = stamp
         ranges = scan.ranges[0] if scan.ranges.shape[0] == 1 else scan.ranges[scan.ranges.shape[0] // 2]
-        msg.ranges = ranges.astype(np.float32).tolist()
-        msg.intensities = [0.0] * len(msg.ranges)
+        msg.ranges = ranges.astype(np.float32)
         yield "scan", msg
 
     def _multilayer(self, scan, stamp, wanted):
