@@ -8,12 +8,12 @@ contributes, against RTK-GNSS as the paper measured and against the simulator's 
    robot by default): odometry's (lsq) distance error and end-point difference against RTK-GNSS.
    Target: the paper's range over five seeds, distance error 0.5 to 2 % and end point 1 to 4 m.
 2. Ablation, on one seed's draw: the ideal robot on flat ground; each imperfection of that draw alone
-   on flat ground (the radii, the steering offsets, the encoders' counts); the ideal robot on
-   tarmac_gravel (the terrain alone); and everything on tarmac_gravel.
+   on flat ground (each tyre's own radius, the load's common radius, the steering offsets, the
+   encoders' counts); the ideal robot on tarmac_gravel (the terrain alone); and everything on
+   tarmac_gravel.
 
-Each run is a simulation of about 90 s, as fast as the machine can (about 35 s of wall time here);
-the figures vary by a few millimetres from run to run (the simulator is not in lockstep with
-base_driver yet). Exit status 1 when the target is missed.
+Each run is a simulation of about 90 s, as fast as the machine can (about 30 s of wall time here),
+in lockstep: a seed gives the same figures on every run. Exit status 1 when the target is missed.
 """
 
 import argparse
@@ -51,11 +51,18 @@ def lsq(figures: dict, against: str = "against_rtk_gnss") -> dict:
 
 
 def only(built, what: str) -> dict:
-    """An as-built file's contents keeping one kind of imperfection of a draw."""
+    """An as-built file's contents keeping one kind of imperfection of a draw: ``radius`` (each tyre's
+    own, without the load), ``loaded`` (the load's common radius, every tyre alike), ``steering``,
+    ``encoders``."""
     data = {"encoders": what == "encoders"}
-    if what in ("radius", "steering"):
-        key = "r_wheel" if what == "radius" else "steering_offset"
-        data["motor_drives"] = {d.name: {key: getattr(d, key)} for d in built.drives}
+    if what == "radius":
+        data["motor_drives"] = {d.name: {"r_wheel": d.r_wheel / (1.0 - built.loaded)} for d in built.drives}
+    elif what == "loaded":
+        data["motor_drives"] = {
+            d.name: {"r_wheel": r * (1.0 - built.loaded)} for d, r in zip(built.drives, built.configured)
+        }
+    elif what == "steering":
+        data["motor_drives"] = {d.name: {"steering_offset": d.steering_offset} for d in built.drives}
     return data
 
 
@@ -93,7 +100,7 @@ def main() -> int:
     print(f"2. ablation, field:{args.ablation_seed}'s imperfections one at a time (odometry lsq against RTK-GNSS)")
     print(f"{'case':>38} {'error':>8} {'end point':>10} {'heading':>9}")
     cases = [("ideal robot, flat ground", "", "flat")]
-    for what in ("radius", "steering", "encoders"):
+    for what in ("radius", "loaded", "steering", "encoders"):
         path = os.path.join(work, f"only_{what}.yaml")
         with open(path, "w") as f:
             yaml.safe_dump(only(built, what), f)

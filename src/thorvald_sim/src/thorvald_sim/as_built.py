@@ -62,15 +62,21 @@ TOP_KEYS = ("motor_drives", "encoders", "delay", "mass_offset")
 class Profile:
     """Tolerances an as-built robot is drawn from."""
 
-    radius: float  # [-] of the configured r_wheel: drawn uniformly from +-radius
+    radius: float  # [-] of the configured r_wheel: drawn uniformly from +-radius, per tyre
     steering_offset: float  # [rad]: drawn uniformly from +-steering_offset (steered drives)
     encoders: bool
+    # [-] the tyres' loaded rolling radius below the configured one, drawn uniformly from this range
+    # once per robot (one load, one pressure for all its tyres)
+    loaded: Tuple[float, float] = (0.0, 0.0)
 
 
 PROFILES: Dict[str, Profile] = {
-    # a field robot: tyre pressure and wear +-1 % of the rolling radius, steering homed within +-0.5 deg,
-    # the encoders counting as configured
-    "field": Profile(radius=0.01, steering_offset=math.radians(0.5), encoders=True),
+    # A field robot: tyre pressure and wear +-1 % of the rolling radius per tyre, steering homed within
+    # +-0.5 deg, the encoders counting as configured; and its tyres loaded: a pneumatic tyre under a
+    # wheel's share of the robot rolls on a radius about a third of its deflection below the free
+    # radius a configuration states (10 to 20 mm of deflection at field pressures on 0.2 m tyres: 1 to
+    # 2 %), so odometry on the configured radius reads long, as the paper's (+1.0 %)
+    "field": Profile(radius=0.01, steering_offset=math.radians(0.5), encoders=True, loaded=(0.01, 0.02)),
 }
 
 
@@ -89,6 +95,7 @@ class AsBuilt:
     delay: float  # [s]
     mass_offset: float  # [kg]
     configured: Tuple[float, ...]  # [m] each drive's r_wheel in the configuration
+    loaded: float = 0.0  # [-] a profile's draw: every tyre's radius this much below its own draw (included in r_wheel)
 
     def drive(self, name: str) -> DriveAsBuilt:
         for d in self.drives:
@@ -169,13 +176,18 @@ def draw_as_built(profile_and_seed: str, config: RobotConfig) -> AsBuilt:
         raise ConfigError("<as-built profile>", [problem], WHAT)
     profile = PROFILES[name]
     rng = random.Random(int(seed_text))
-    drives = []
-    for i, d in enumerate(config.drives):
+    draws = []
+    for d in config.drives:
         # two draws a drive, steered or not, so one drive's type does not move the others' draws
         scale = 1.0 + rng.uniform(-profile.radius, profile.radius)
         offset = rng.uniform(-profile.steering_offset, profile.steering_offset)
-        drives.append(DriveAsBuilt(_name(i), d.r_wheel * scale, offset if d.steerable else 0.0))
-    return AsBuilt(profile_and_seed, tuple(drives), profile.encoders, 0.0, 0.0, _radii(config))
+        draws.append((scale, offset if d.steerable else 0.0))
+    loaded = rng.uniform(*profile.loaded)  # after the drives' draws: theirs stay as they were without it
+    drives = tuple(
+        DriveAsBuilt(_name(i), d.r_wheel * scale * (1.0 - loaded), offset)
+        for i, (d, (scale, offset)) in enumerate(zip(config.drives, draws))
+    )
+    return AsBuilt(profile_and_seed, drives, profile.encoders, 0.0, 0.0, _radii(config), loaded)
 
 
 def as_built_for(spec: str, config: RobotConfig) -> AsBuilt:
@@ -288,7 +300,7 @@ def for_simulator(as_built: AsBuilt, config: RobotConfig) -> SimAsBuilt:
 def describe_as_built(built: AsBuilt) -> str:
     """One line for reports: each drive's radius against the configured one [%] and its steering
     offset [deg], the encoders, the delay and the load."""
-    drives = []
+    drives = [f"tyres loaded {-built.loaded * 100:+.2f} % (in every r below)"] if built.loaded else []
     for d, radius in zip(built.drives, built.configured):
         text = f"{d.name} r {(d.r_wheel / radius - 1.0) * 100:+.2f} %"
         if d.steering_offset:

@@ -13,6 +13,7 @@ from thorvald_sim.as_built import (
     SimAsBuilt,
     as_built_for,
     as_configured,
+    describe_as_built,
     draw_as_built,
     for_simulator,
     load_as_built,
@@ -109,12 +110,20 @@ def test_the_field_profile_is_seeded_and_within_its_tolerances():
     a, b, c = draw_as_built("field:1", STD), draw_as_built("field:1", STD), draw_as_built("field:2", STD)
     assert a == b and a != c and a.encoders and a.source == "field:1"
     for built in (a, c):
+        # the loaded tyres: 1 to 2 % below the configured radius, one draw for the robot
+        assert 0.01 <= built.loaded <= 0.02
         for d, conf in zip(built.drives, STD.drives):
-            assert abs(d.r_wheel / conf.r_wheel - 1) <= 0.01
+            # then +-1 % per tyre
+            assert abs(d.r_wheel / (conf.r_wheel * (1 - built.loaded)) - 1) <= 0.01
             assert abs(d.steering_offset) <= math.radians(0.5)
     # over many seeds the draws fill their tolerances (uniform): not all the same, both signs
-    scales = [draw_as_built(f"field:{s}", STD).drives[0].r_wheel / STD.drives[0].r_wheel - 1 for s in range(200)]
+    drawn = [draw_as_built(f"field:{s}", STD) for s in range(200)]
+    scales = [d.drives[0].r_wheel / (STD.drives[0].r_wheel * (1 - d.loaded)) - 1 for d in drawn]
     assert min(scales) < -0.008 and max(scales) > 0.008
+    loads = [d.loaded for d in drawn]
+    assert min(loads) < 0.011 and max(loads) > 0.019
+    # every tyre loaded alike: the radii's mean falls by the load, their spread is the tyres'
+    assert "tyres loaded" in describe_as_built(a) and "tyres loaded" not in describe_as_built(as_configured(STD))
     # a drive that does not steer is drawn no offset
     assert all(d.steering_offset == 0 for d in draw_as_built("field:3", DIFF).drives)
 
