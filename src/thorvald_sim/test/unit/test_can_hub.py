@@ -79,7 +79,7 @@ def test_a_dropped_port_comes_back_at_its_link(hub):
     bus = open_port(links / "port0")
     h.drop(0)
     with pytest.raises(can.CanError):
-        for _ in range(50):  # the adapter is gone: reading fails
+        for _ in range(200):  # the adapter is gone: reading fails (within 10 s, on a busy machine too)
             bus.recv(0.05)
     with contextlib.suppress(can.CanError):
         bus.shutdown()  # python-can writes "C" to the adapter first
@@ -88,7 +88,7 @@ def test_a_dropped_port_comes_back_at_its_link(hub):
     other = open_port(links / "port1")
     try:
         other.send(can.Message(arbitration_id=0x42, data=[4], is_extended_id=False))
-        got = again.recv(2.0)
+        got = again.recv(5.0)  # generous: the test failed once while a CI ran beside it
         assert got is not None and got.arbitration_id == 0x42
     finally:
         again.shutdown()
