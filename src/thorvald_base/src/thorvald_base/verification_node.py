@@ -66,9 +66,12 @@ class VerificationDrive:
         topics = rospy.get_param("~recorded_topics", [])
         self.recorded = [rospy.resolve_name(t) for t in (topics.split() if isinstance(topics, str) else topics)]
         self.unconnected = [(self.recorder, t) for t in self.recorded] if self.recorder else []
-        for pair in rospy.get_param("~connections", []):
-            node, topic = str(pair).split()
-            self.unconnected.append((rospy.resolve_name(node), rospy.resolve_name(topic)))
+        connections = rospy.get_param("~connections", [])
+        for pair in connections if isinstance(connections, list) else [connections]:
+            words = str(pair).split()
+            if len(words) != 2:
+                raise RuntimeError(f"~connections: {pair!r}: an entry is 'NODE TOPIC', e.g. 'base_driver drive_states'")
+            self.unconnected.append((rospy.resolve_name(words[0]), rospy.resolve_name(words[1])))
         unpause = str(rospy.get_param("~unpause", "") or "")
         self.unpause = rospy.resolve_name(unpause) if unpause else ""
         self.recorder_checked = 0.0  # [s] wall
