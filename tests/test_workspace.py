@@ -10,6 +10,7 @@ import subprocess
 import pytest
 import rosbag
 
+from thorvald_bringup.report_bag import read_recording
 from thorvald_testing import free_port
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
@@ -146,23 +147,15 @@ def test_the_same_seed_in_lockstep_gives_the_same_report_beside_a_busy_core(demo
                 bound = 1e-3 if key.endswith("_m") else 1e-3 * 100 / 80 if key.endswith("percent") else 0.01
                 assert abs(again[table][path][key] - value) <= bound, (table, path, key, value, again[table][path][key])
     # the recordings themselves: ground truth and odometry at every common instant, within a millimetre
-    for topic in ("odometry/gazebo", "odometry/base_raw"):
-        a, b = poses(os.path.join(first, "odometry_report.bag"), topic), poses(tmp_path / "odometry_report.bag", topic)
-        common = sorted(set(a) & set(b))
-        assert len(common) > 4000, topic  # 90 s at 50 Hz
-        worst = max(math.hypot(a[t][0] - b[t][0], a[t][1] - b[t][1]) for t in common)
-        assert worst < 1e-3, (topic, worst)
-
-
-def poses(bag_path, ending):
-    """{stamp [ns]: (x, y)} of the topic of the bag ending in ending."""
-    out = {}
-    with rosbag.Bag(str(bag_path)) as bag:
-        (topic,) = [t for t in bag.get_type_and_topic_info().topics if t.endswith("/" + ending)]
-        for _, msg, _ in bag.read_messages(topics=[topic]):
-            p = msg.pose.pose.position
-            out[msg.header.stamp.to_nsec()] = (p.x, p.y)
-    return out
+    a = read_recording(os.path.join(first, "odometry_report.bag"))
+    b = read_recording(str(tmp_path / "odometry_report.bag"))
+    for name in ("truth", "odometry"):
+        pa, pb = getattr(a, name), getattr(b, name)
+        xy_a, xy_b = dict(zip(pa.t, zip(pa.x, pa.y))), dict(zip(pb.t, zip(pb.x, pb.y)))
+        common = sorted(set(xy_a) & set(xy_b))
+        assert len(common) > 4000, name  # 90 s at 50 Hz
+        worst = max(math.hypot(xy_a[t][0] - xy_b[t][0], xy_a[t][1] - xy_b[t][1]) for t in common)
+        assert worst < 1e-3, (name, worst)
 
 
 def test_verification_drive_on_base_drivers_own_simulated_drives():

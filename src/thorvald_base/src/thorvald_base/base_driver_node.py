@@ -258,9 +258,10 @@ class BaseDriverNode:
 
     # ---- callbacks: message -> core -> message -----------------------------------------------
     def on_cmd_vel(self, msg):
-        with self.stamped_arrived:
-            if self.stamped.active:  # following a stamped stream (lockstep)
-                return
+        if self.lockstep:
+            with self.stamped_arrived:
+                if self.stamped.active:  # following a stamped stream
+                    return
         with self.lock:
             refused = self.core.set_command(msg.linear.x, msg.linear.y, msg.angular.z, rospy.get_time())
         if refused:

@@ -9,7 +9,7 @@ import math
 from typing import Dict, List, Sequence
 
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
-from geometry_msgs.msg import Quaternion, TransformStamped
+from geometry_msgs.msg import Quaternion, TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import BatteryState, JointState
 from std_msgs.msg import Header
@@ -163,6 +163,21 @@ def pose_odometry_msg(
         msg.pose.covariance = list(pose_covariance)
     if twist_covariance is not None:
         msg.twist.covariance = list(twist_covariance)
+    return msg
+
+
+def twist_msg(twist: Sequence[float]) -> Twist:
+    """A planar twist (vx [m/s], vy [m/s], wz [rad/s]) as a Twist."""
+    msg = Twist()
+    msg.linear.x, msg.linear.y, msg.angular.z = twist
+    return msg
+
+
+def twist_stamped_msg(stamp, twist: Sequence[float]) -> TwistStamped:
+    """A planar twist stamped with the instant it holds from."""
+    msg = TwistStamped()
+    msg.header.stamp = stamp
+    msg.twist = twist_msg(twist)
     return msg
 
 

@@ -43,9 +43,10 @@ from std_srvs.srv import Empty
 
 from thorvald_model import ConfigError, load_robot_config
 
+from . import conversions
 from .verification import duration, plan_for, report, twist_at
 
-RECORDER_POLL = 0.2  # [s] wall between questions to the publishers of the recorded topics
+CONNECTION_POLL = 0.2  # [s] wall between questions to the publishers of the awaited topics
 
 
 class VerificationDrive:
@@ -74,7 +75,7 @@ class VerificationDrive:
             self.unconnected.append((rospy.resolve_name(words[0]), rospy.resolve_name(words[1])))
         unpause = str(rospy.get_param("~unpause", "") or "")
         self.unpause = rospy.resolve_name(unpause) if unpause else ""
-        self.recorder_checked = 0.0  # [s] wall
+        self.connections_checked = 0.0  # [s] wall
         ready_topic = str(rospy.get_param("~ready_topic", ""))
         self.ready = not ready_topic
         if ready_topic:
@@ -100,11 +101,11 @@ class VerificationDrive:
 
     def connected_all(self) -> bool:
         """Whether every awaited node (the recorder, ~connections) has a connection from every
-        publisher of its topic (asked at most every RECORDER_POLL s of wall time: one XML-RPC call
+        publisher of its topic (asked at most every CONNECTION_POLL s of wall time: one XML-RPC call
         per publisher)."""
-        if not self.unconnected or time.time() - self.recorder_checked < RECORDER_POLL:
+        if not self.unconnected or time.time() - self.connections_checked < CONNECTION_POLL:
             return not self.unconnected
-        self.recorder_checked = time.time()
+        self.connections_checked = time.time()
         self.unconnected = [(node, t) for node, t in self.unconnected if not connected_to(node, t)]
         return not self.unconnected
 
@@ -166,23 +167,18 @@ class VerificationDrive:
         self.points = []
         self.recording = True
         start_wall = None
-        first = True
+        if paused:
+            stamped = self.publish_ahead(stamped, start)
+            time.sleep(0.1)  # the first stamped commands on their way to base_driver before the world moves
+            self.unpause_simulator()
         while self.sim_time < stop and not rospy.is_shutdown():
             if start_wall is None and self.sim_time >= start:
                 start_wall = time.time()
-            # ahead of its instant by a period and a step: base_driver in lockstep, waiting at an
-            # instant before our next wake-up, already holds a command stamped after it
-            while stamped * period <= self.sim_time + period + self.step:
-                self.stamped_pub.publish(stamped_msg(stamped * period, self.twist_for(stamped * period - start)))
-                stamped += 1
-            if first and paused:
-                time.sleep(0.1)  # the first stamped commands on their way to base_driver before the world moves
-                self.unpause_simulator()
-            first = False
+            stamped = self.publish_ahead(stamped, start)
             k = math.floor(self.sim_time / period + 1e-9)
             if k != plain:
                 plain = k
-                self.cmd_pub.publish(twist_msg(self.twist_for(k * period - start)))
+                self.cmd_pub.publish(conversions.twist_msg(self.twist_for(k * period - start)))
             self.tick()
         self.recording = False
         points = [(x, y) for t, x, y in self.points if start - 1e-6 <= t <= stop + 1e-6]
@@ -196,6 +192,17 @@ class VerificationDrive:
             wall=time.time() - (start_wall or time.time()),
         )
 
+    def publish_ahead(self, index: int, start: float) -> int:
+        """Publishes the stamped commands from the one of index (its instant index x the command
+        period) up to a period and a step ahead of now: base_driver in lockstep, waiting at an instant
+        before our next wake-up, already holds a command stamped after it. The next index."""
+        period = self.command_period
+        while index * period <= self.sim_time + period + self.step:
+            stamp = rospy.Time.from_sec(index * period)
+            self.stamped_pub.publish(conversions.twist_stamped_msg(stamp, self.twist_for(index * period - start)))
+            index += 1
+        return index
+
     def unpause_simulator(self):
         try:
             rospy.wait_for_service(self.unpause, timeout=self.startup_timeout)
@@ -208,19 +215,6 @@ class VerificationDrive:
         """The plan's twist at t [s] from its start; standing still before and after it."""
         twist = twist_at(self.plan, t) if t >= 0 else None
         return (twist.vx, twist.vy, twist.wz) if twist is not None else (0.0, 0.0, 0.0)
-
-
-def twist_msg(twist):
-    msg = TwistMsg()
-    msg.linear.x, msg.linear.y, msg.angular.z = twist
-    return msg
-
-
-def stamped_msg(t, twist):
-    msg = TwistStamped()
-    msg.header.stamp = rospy.Time.from_sec(t)
-    msg.twist = twist_msg(twist)
-    return msg
 
 
 def connected_to(subscriber: str, topic: str) -> bool:

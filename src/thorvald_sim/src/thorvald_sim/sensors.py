@@ -133,11 +133,6 @@ class InstantNoise:
         return self.generator
 
 
-def noise_generator(seed: int, robot: str, sensor: str) -> InstantNoise:
-    """A sensor's own noise: the same seed, robot, sensor and instant give the same draws."""
-    return InstantNoise(seed, robot, sensor)
-
-
 class Schedule:
     """The instants of a rate [Hz] on simulated time: the multiples of its period (the same whenever
     the sensor began to be read); rate 0: every physics step."""
@@ -469,7 +464,7 @@ def build_sensors(
         except MountError as e:
             problems.append(f"{spec.describe()}: {e}")
             continue
-        noise = noise_generator(seed, robot.name, spec.name + "@" + spec.link)
+        noise = InstantNoise(seed, robot.name, spec.name + "@" + spec.link)
         extra = {}
         if spec.kind == "imu":
             extra["gravity"] = gravity

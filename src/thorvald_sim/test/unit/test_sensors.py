@@ -18,10 +18,10 @@ from thorvald_sim.sensors import (
     WARN,
     WGS84_A,
     WGS84_E2,
+    InstantNoise,
     Schedule,
     SensorUse,
     depth_to_points,
-    noise_generator,
     sensor_report,
 )
 from thorvald_sim.simulation import Simulation
@@ -303,22 +303,22 @@ def test_a_schedules_instants_are_its_periods_multiples_whenever_it_began():
 
 
 def test_noise_is_seeded():
-    a = noise_generator(7, "r1", "lidar").at(3).normal(size=5)
-    assert np.array_equal(a, noise_generator(7, "r1", "lidar").at(3).normal(size=5))
-    assert not np.array_equal(a, noise_generator(8, "r1", "lidar").at(3).normal(size=5))
-    assert not np.array_equal(a, noise_generator(7, "r2", "lidar").at(3).normal(size=5))
-    assert not np.array_equal(a, noise_generator(7, "r1", "lidar").at(4).normal(size=5))
+    a = InstantNoise(7, "r1", "lidar").at(3).normal(size=5)
+    assert np.array_equal(a, InstantNoise(7, "r1", "lidar").at(3).normal(size=5))
+    assert not np.array_equal(a, InstantNoise(8, "r1", "lidar").at(3).normal(size=5))
+    assert not np.array_equal(a, InstantNoise(7, "r2", "lidar").at(3).normal(size=5))
+    assert not np.array_equal(a, InstantNoise(7, "r1", "lidar").at(4).normal(size=5))
 
 
 def test_an_instants_noise_does_not_depend_on_what_was_drawn_before():
     # a run whose recorder subscribed later drew less before: the same instant still draws the same
-    late, early = noise_generator(7, "r1", "gps"), noise_generator(7, "r1", "gps")
+    late, early = InstantNoise(7, "r1", "gps"), InstantNoise(7, "r1", "gps")
     for k in range(50):
         early.at(k).normal(size=720)
     assert np.array_equal(late.at(50).normal(size=3), early.at(50).normal(size=3))
     # and consecutive instants' streams do not overlap: many draws at one instant never reach the next's
-    many = noise_generator(7, "r1", "gps").at(50).standard_normal(100000)
-    following = noise_generator(7, "r1", "gps").at(51).standard_normal(4)
+    many = InstantNoise(7, "r1", "gps").at(50).standard_normal(100000)
+    following = InstantNoise(7, "r1", "gps").at(51).standard_normal(4)
     assert not any(np.array_equal(following, many[i : i + 4]) for i in range(len(many) - 3))
 
 

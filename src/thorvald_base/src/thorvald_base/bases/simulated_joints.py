@@ -29,7 +29,7 @@ and a measured one read as v * r_now / r_spawn. Angles (steering, wheel) cross u
 import threading
 from collections import deque
 from dataclasses import replace
-from typing import Callable, List, Optional, Sequence, Tuple
+from typing import Callable, Optional, Sequence, Tuple
 
 from ..errors import ParameterError
 from ..kinematics import DriveCommand
@@ -50,8 +50,7 @@ class SimulatedJointsBase(BaseHandle):
         self._send = send
         self.stale_after = stale_after
         self._lock = threading.Lock()
-        self._measured: List[MeasuredDrive] = [MeasuredDrive(0.0, 0.0, 0.0, 0.0) for _ in config.drives]
-        self._measured_time: Optional[float] = None
+        self._unmeasured = [MeasuredDrive(0.0, 0.0, 0.0, 0.0) for _ in config.drives]  # read before any came
         self._history = deque(maxlen=HISTORY)  # (time, states) of the last measurements, oldest first
         self._topics = None
         self._arrived = threading.Condition(self._lock)  # lockstep: new drive states
@@ -80,21 +79,24 @@ class SimulatedJointsBase(BaseHandle):
         with self._lock:
             if self._history and time < self._history[-1][0]:
                 self._history.clear()  # simulated time went back (a reset)
-            self._measured = list(states)
-            self._measured_time = time
-            self._history.append((time, self._measured))
+            self._history.append((time, list(states)))
             self._arrived.notify_all()
+
+    @property
+    def _measured_time(self) -> Optional[float]:
+        """When the newest measurement was taken [s] (None before any); under the lock."""
+        return self._history[-1][0] if self._history else None
 
     def wait_for_states(self, after: Optional[float], timeout: float) -> Optional[float]:
         """Lockstep: the time [s] of drive states newer than after (None: any), waiting up to timeout
         [s] of wall time for them; None if none came."""
-        with self._arrived:
-            self._arrived.wait_for(
-                lambda: self._measured_time is not None and (after is None or self._measured_time > after + 1e-9),
-                timeout,
-            )
+
+        def newer() -> bool:
             t = self._measured_time
-        return t if t is not None and (after is None or t > after + 1e-9) else None
+            return t is not None and (after is None or t > after + SAME_INSTANT)
+
+        with self._arrived:
+            return self._measured_time if self._arrived.wait_for(newer, timeout) else None
 
     def answer(self, time: float) -> None:
         """Lockstep: answers drive states of an instant that is not a cycle of base_driver's with the
@@ -117,11 +119,11 @@ class SimulatedJointsBase(BaseHandle):
 
     def _read_drive_states(self, time):
         with self._lock:
-            measured = self._measured  # newest; unless newer than time, then the newest at or before it
-            for t, states in reversed(self._history):
-                if t <= time + SAME_INSTANT:
-                    measured = states
-                    break
+            # the newest taken at or before time; the newest of all if every one is newer (the clock lags)
+            measured = next(
+                (states for t, states in reversed(self._history) if t <= time + SAME_INSTANT),
+                self._history[-1][1] if self._history else self._unmeasured,
+            )
             measured = list(measured)
         return [replace(m, speed=m.speed * k) if k != 1.0 else m for m, k in zip(measured, self._scales)]
 
