@@ -201,8 +201,8 @@ def test_base_bringup_launch(install):
 
 
 def test_every_module_is_installed_and_imports(install):
-    """Every module of the source tree is in the install space (a setup.py listing packages by hand
-    once left thorvald_base.can out) and imports from there."""
+    """Every module of the source tree, and the C module, is in the install space (a setup.py
+    listing packages by hand once left thorvald_base.can out) and imports from there."""
     sources = []
     for pkg in sorted(os.listdir(os.path.join(WS, "src"))):
         top = os.path.join(WS, "src", pkg, "src")
@@ -212,6 +212,7 @@ def test_every_module_is_installed_and_imports(install):
                     rel = os.path.relpath(os.path.join(folder, name), top)[: -len(".py")]
                     sources.append(rel.replace(os.sep, ".").replace(".__init__", ""))
     assert "thorvald_base.can.protocol" in sources and len(sources) > 60
+    sources.append("thorvald_sim._scan")  # the C module (src/thorvald_sim/csrc/scan.c), built and installed by cmake
     script = (
         "import importlib, json, sys; out = {}\n"
         "for m in sys.argv[1:]:\n"

@@ -59,8 +59,39 @@ Quat = Tuple[float, float, float, float]
 Transform = Tuple[Vec3, Quat]
 IDENTITY: Transform = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
+try:  # the arithmetic around a lidar's rays in C (csrc/scan.c, built by catkin_make); numpy otherwise
+    from . import _scan
+except ImportError:  # pragma: no cover - a build without Python's headers
+    _scan = None
+
 _FRACTION = operator.itemgetter(2)  # of a rayTestBatch result: (object, link, fraction, ...)
 RAY_BATCH = 16384  # pybullet's largest rayTestBatch (MAX_RAY_INTERSECTION_BATCH_SIZE)
+
+
+def beams(pose: Transform, directions: np.ndarray, limits: Tuple[float, float], out, *, compiled: bool = True) -> None:
+    """The beams' start and end points in the world, into out = (starts, ends) (N x 3 each): origin +
+    R d range_min and origin + R d range_max for each unit direction d (N x 3, the sensor frame), pose
+    = (origin, quaternion) the sensor's in the world, limits = (range_min, range_max). compiled: the C
+    loop of ``_scan`` where it is built (the same figures to a few ulp)."""
+    (origin, quat), (range_min, range_max), (starts, ends) = pose, limits, out
+    if compiled and _scan is not None:
+        _scan.beams(quat, origin, directions, range_min, range_max, starts, ends)
+        return
+    d = directions @ np.asarray(p.getMatrixFromQuaternion(quat)).reshape(3, 3).T
+    np.add(origin, d * range_min, out=starts)
+    np.add(origin, d * range_max, out=ends)
+
+
+def ranges_from_hits(hits, out: np.ndarray, limits: Tuple[float, float], *, compiled: bool = True) -> None:
+    """rayTestBatch's results (one per ray, cast from range_min to range_max: limits) as ranges into
+    out: inf for a ray that hit nothing (fraction 1.0; a return at range_max is out of range anyway).
+    compiled: the C loop of ``_scan`` where it is built (the same figures)."""
+    range_min, range_max = limits
+    if compiled and _scan is not None:
+        _scan.ranges(hits, out, range_min, range_max)
+        return
+    fractions = np.fromiter(map(_FRACTION, hits), float, len(hits))
+    out[: len(hits)] = np.where(fractions >= 1.0, np.inf, range_min + fractions * (range_max - range_min))
 
 
 class MountError(Exception):
@@ -222,24 +253,20 @@ class Lidar(Sensor):
             v = np.array([c.vertical_min_angle])
         vv, hh = np.meshgrid(v, h, indexing="ij")
         self.directions = np.stack([np.cos(vv) * np.cos(hh), np.cos(vv) * np.sin(hh), np.sin(vv)], axis=-1)
-        self._flat = self.directions.reshape(-1, 3)
+        self._flat = np.ascontiguousarray(self.directions.reshape(-1, 3))
+        # the beams' ends in the world, rewritten at each reading (rayTestBatch copies them)
+        self._starts, self._ends = np.empty_like(self._flat), np.empty_like(self._flat)
 
     def read(self, now: float) -> Scan:
         c: RayConfig = self.spec.config
-        origin, quat = self.pose()
-        m = np.asarray(p.getMatrixFromQuaternion(quat)).reshape(3, 3)
-        d = self._flat @ m.T
-        o = np.asarray(origin)
+        starts, ends = self._starts, self._ends
+        limits = (c.range_min, c.range_max)
         # pybullet takes the arrays as they are (a list of them costs a fifth of the rays' time)
-        starts = o + d * c.range_min
-        ends = o + d * c.range_max
-        fractions = np.empty(len(d))
-        for k in range(0, len(d), RAY_BATCH):
+        beams(self.pose(), self._flat, limits, (starts, ends))
+        ranges = np.empty(len(starts))
+        for k in range(0, len(starts), RAY_BATCH):
             hits = p.rayTestBatch(starts[k : k + RAY_BATCH], ends[k : k + RAY_BATCH], physicsClientId=self.client)
-            # a ray that hits nothing has the fraction 1.0 (and a return at range_max is out of range anyway)
-            fractions[k : k + len(hits)] = np.fromiter(map(_FRACTION, hits), float, len(hits))
-        fractions[fractions >= 1.0] = np.inf
-        ranges = c.range_min + fractions * (c.range_max - c.range_min)
+            ranges_from_hits(hits, ranges[k : k + len(hits)], limits)
         if c.noise_stddev > 0:  # every beam drawn (inf stays inf): the same draws whatever the beams hit
             ranges += self.rng.normal(c.noise_mean, c.noise_stddev, ranges.shape)
         elif c.noise_mean != 0:

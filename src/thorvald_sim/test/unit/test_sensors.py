@@ -11,6 +11,7 @@ import numpy as np
 import pybullet as p
 import pytest
 
+import thorvald_sim.sensors as sensors_module
 from thorvald_sim.robot import Pose2D
 from thorvald_sim.sensor_blocks import Datum
 from thorvald_sim.sensors import (
@@ -21,7 +22,9 @@ from thorvald_sim.sensors import (
     InstantNoise,
     Schedule,
     SensorUse,
+    beams,
     depth_to_points,
+    ranges_from_hits,
     sensor_report,
 )
 from thorvald_sim.simulation import Simulation
@@ -358,3 +361,45 @@ def test_the_sensor_report_names_a_sensor_that_cannot_hold_its_rate():
     # a rate above the physics rate is measured once a step at most
     level, message, _ = sensor_report([SensorUse("imu i (/imu)", 1000.0, 0.01, 480)], 2.0, 240.0, 0.0)
     assert level == WARN and "above the physics rate" in message
+
+
+def test_the_lidar_arithmetic_is_built_in_c():
+    # catkin_make builds csrc/scan.c (tools/setup installs Python's headers); numpy is only the fallback
+    assert sensors_module._scan is not None
+
+
+def test_the_compiled_beams_and_ranges_are_numpys():
+    rng = np.random.default_rng(11)
+    directions = rng.normal(size=(721, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    for _ in range(20):
+        q = rng.normal(size=4)
+        quat, origin = tuple(q / np.linalg.norm(q)), tuple(rng.uniform(-50.0, 50.0, 3))
+        out = [np.empty_like(directions) for _ in range(4)]
+        beams((origin, quat), directions, (0.1, 30.0), out[:2])
+        beams((origin, quat), directions, (0.1, 30.0), out[2:], compiled=False)
+        assert np.allclose(out[0], out[2], rtol=0, atol=1e-12) and np.allclose(out[1], out[3], rtol=0, atol=1e-12)
+        # the geometry itself: each beam starts 0.1 m and ends 30 m from the origin, along the turned direction
+        assert np.allclose(np.linalg.norm(out[1] - origin, axis=1), 30.0)
+        assert np.allclose(out[1] - origin, 300.0 * (out[0] - origin))
+    fractions = [0.0, 0.25, 0.5, 0.999999, 1.0, 1.0, 0.0125]
+    hits = tuple((3, -1, f, (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)) for f in fractions)  # rayTestBatch's shape
+    compiled, numpy = np.full(9, -1.0), np.full(9, -1.0)
+    ranges_from_hits(hits, compiled[1:8], (0.1, 30.0))
+    ranges_from_hits(hits, numpy[1:8], (0.1, 30.0), compiled=False)
+    assert np.array_equal(compiled, numpy)
+    assert compiled[0] == -1.0 and compiled[8] == -1.0  # only the slice written
+    assert compiled[3] == 0.1 + 0.5 * 29.9 and math.isinf(compiled[5]) and math.isinf(compiled[6])
+
+
+def test_the_compiled_loops_refuse_what_they_cannot_read():
+    hits = ((3, -1, 0.5, (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)),) * 4
+    with pytest.raises(ValueError, match="out must be C-contiguous float64 with room for 4"):
+        ranges_from_hits(hits, np.empty(3), (0.1, 30.0))
+    with pytest.raises(ValueError, match="float64"):
+        ranges_from_hits(hits, np.empty(4, dtype=np.float32), (0.1, 30.0))
+    with pytest.raises(TypeError, match="result 1 is not a rayTestBatch result"):
+        ranges_from_hits((hits[0], (1, 2)), np.empty(2), (0.1, 30.0))
+    directions = np.ones((5, 3))
+    with pytest.raises(ValueError, match="ends must be"):
+        beams(((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)), directions, (0.1, 30.0), (np.empty((5, 3)), np.empty((4, 3))))
