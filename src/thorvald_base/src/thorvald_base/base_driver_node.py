@@ -93,6 +93,7 @@ from .stamped_commands import StampedCommands
 STATUS_PERIOD = 1.0  # [s] between battery_data / motor_controller_data messages
 EXIT_REFUSED = 1  # exit status when the node refuses to start
 STAMPED_WAIT = 2.0  # [s] of wall time a lockstep cycle waits for its stamped command before letting the source go
+RECORDED_QUEUE = 100  # messages queued per reader of the per-cycle streams (2 s at 50 Hz) before rospy drops one
 
 
 def load_config(raw: dict, params: DriverParams, names: Names = None):
@@ -187,10 +188,14 @@ class BaseDriverNode:
         self.lock = threading.Lock()
         self.joint_names = conversions.joint_names(self.config.drives, self.tf_prefix)
 
-        self.odom_pub = rospy.Publisher(names.topic("odometry/base_raw"), Odometry, queue_size=10)
-        self.joint_pub = rospy.Publisher(names.topic("joint_states"), JointState, queue_size=10)
-        self.state_pub = rospy.Publisher(names.topic("base_state"), BaseState, queue_size=10)
-        self.command_pub = rospy.Publisher(names.topic("joint_commands"), BaseState, queue_size=10)
+        # Every cycle's odometry and states, also to a recorder on a loaded machine: rospy writes to each
+        # reader from a thread of its own and drops the oldest message when its queue is full; with 10
+        # (0.2 s at 50 Hz) a writer thread starved beside a busy core lost five base_state messages of a
+        # recorded drive, and the report replayed from them differed by 14 mm
+        self.odom_pub = rospy.Publisher(names.topic("odometry/base_raw"), Odometry, queue_size=RECORDED_QUEUE)
+        self.joint_pub = rospy.Publisher(names.topic("joint_states"), JointState, queue_size=RECORDED_QUEUE)
+        self.state_pub = rospy.Publisher(names.topic("base_state"), BaseState, queue_size=RECORDED_QUEUE)
+        self.command_pub = rospy.Publisher(names.topic("joint_commands"), BaseState, queue_size=RECORDED_QUEUE)
         self.battery_pub = rospy.Publisher(names.topic("battery_data"), BatteryArray, queue_size=1)
         self.controller_pub = rospy.Publisher(names.topic("motor_controller_data"), ControllerArray, queue_size=1)
         self.io_pub = rospy.Publisher(names.topic("io_data"), IOArray, queue_size=1)
