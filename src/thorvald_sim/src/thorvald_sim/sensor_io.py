@@ -11,7 +11,7 @@ import math
 import struct
 import time
 from io import BytesIO
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 import rospy
@@ -66,81 +66,65 @@ CAMERA_DTYPE = np.dtype(
 )
 
 
-_HEADER = struct.Struct("<3I")  # seq, stamp secs, nsecs; then frame_id as a length and its bytes
-_LENGTH = struct.Struct("<I")
-_SCAN = struct.Struct("<7f")  # angle_min, angle_max, angle_increment, time_increment, scan_time, range_min, range_max
+_LENGTH = struct.Struct("<I")  # a ROS array's length
 
 
-class FastLaserScan(LaserScan):
-    """A LaserScan whose ``ranges`` and ``intensities`` are float32 numpy arrays, serialised with
-    their bytes as they are. genpy packs a float array float by float from a list (a list that must
-    be made first): for 720 beams at 40 Hz, half of what publishing a scan cost beyond its rays. The
-    bytes are genpy's (``test_sensor_io``); readers see a plain sensor_msgs/LaserScan."""
-
-    __slots__ = ()
-
-    def serialize(self, buff):
-        h = self.header
-        frame = h.frame_id.encode()
-        buff.write(_HEADER.pack(h.seq, h.stamp.secs, h.stamp.nsecs))
-        buff.write(_LENGTH.pack(len(frame)))
-        buff.write(frame)
-        buff.write(
-            _SCAN.pack(
-                self.angle_min,
-                self.angle_max,
-                self.angle_increment,
-                self.time_increment,
-                self.scan_time,
-                self.range_min,
-                self.range_max,
-            )
-        )
-        for values in (self.ranges, self.intensities):
-            buff.write(_LENGTH.pack(len(values)))
-            buff.write(np.ascontiguousarray(values, dtype="<f4").tobytes())
-
-
-class _ArrayData:
-    """A message whose ``data`` (uint8[]) may be a numpy array, serialised with its bytes as they are.
-    genpy packs a ``data`` of bytes through ``struct`` (a copy) after the caller made the bytes (a
-    copy): for a 320 x 240 depth camera's cloud, 2.4 MB twice a frame, a fifth of what publishing
-    a frame cost beyond its render. The fields before and after ``data`` are genpy's own: it writes
-    the message with an empty ``data``, and the array's length and bytes go where its zero length
-    was. Readers see the plain message (``test_sensor_io`` compares the bytes)."""
+class _ArrayFields:
+    """A message whose last array fields (``ARRAYS``: name and element type, in order, followed by
+    ``TAIL`` bytes of other fields) may be numpy arrays, serialised with their bytes as they are.
+    genpy packs a float array float by float from a list that must be made first, and a uint8[]
+    through ``struct`` after the caller made its bytes: for 720 beams at 40 Hz half of what
+    publishing a scan cost beyond its rays; for a 320 x 240 depth camera's cloud 2.4 MB copied twice
+    a frame. Every other field is genpy's own: it writes the message with those arrays empty, and
+    each array's length and bytes go where its zero length was. Readers see the plain message
+    (``test_sensor_io`` compares the bytes)."""
 
     __slots__ = ()
-    TAIL = 0  # bytes genpy writes after data
+    ARRAYS: Tuple[Tuple[str, str], ...] = ()
+    TAIL = 0  # bytes genpy writes after the arrays
 
     def serialize(self, buff):
-        data = self.data
-        if not isinstance(data, np.ndarray):
+        arrays = [getattr(self, name) for name, _ in self.ARRAYS]
+        if not all(isinstance(a, np.ndarray) for a in arrays):
             return super().serialize(buff)
-        self.data = b""
         try:
+            for name, _ in self.ARRAYS:
+                setattr(self, name, b"")
             rest = BytesIO()
             super().serialize(rest)
         finally:
-            self.data = data
+            for (name, _), a in zip(self.ARRAYS, arrays):
+                setattr(self, name, a)
         rest = rest.getbuffer()
         end = len(rest) - self.TAIL
-        octets = np.ascontiguousarray(data).reshape(-1).view(np.uint8)
-        buff.write(rest[: end - _LENGTH.size])
-        buff.write(_LENGTH.pack(octets.size))
-        buff.write(octets)
+        buff.write(rest[: end - _LENGTH.size * len(arrays)])
+        for (_, kind), a in zip(self.ARRAYS, arrays):
+            a = np.ascontiguousarray(a).reshape(-1)
+            a = a.view(np.uint8) if kind == "<u1" else a.astype(kind, copy=False)  # uint8[]: the array's bytes
+            buff.write(_LENGTH.pack(a.size))
+            buff.write(a)
         buff.write(rest[end:])
 
 
-class FastImage(_ArrayData, Image):
+class FastLaserScan(_ArrayFields, LaserScan):
+    """A LaserScan whose ``ranges`` and ``intensities`` may be numpy arrays (float32)."""
+
+    __slots__ = ()
+    ARRAYS = (("ranges", "<f4"), ("intensities", "<f4"))
+
+
+class FastImage(_ArrayFields, Image):
     """An Image whose ``data`` may be a numpy array (its bytes, row after row)."""
 
     __slots__ = ()
+    ARRAYS = (("data", "<u1"),)
 
 
-class FastPointCloud2(_ArrayData, PointCloud2):
+class FastPointCloud2(_ArrayFields, PointCloud2):
     """A PointCloud2 whose ``data`` may be a numpy array of its points (its bytes, point after point)."""
 
     __slots__ = ()
+    ARRAYS = (("data", "<u1"),)
     TAIL = 1  # is_dense
 
 
