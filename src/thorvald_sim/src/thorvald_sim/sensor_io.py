@@ -274,15 +274,15 @@ class SensorIO:
         if wanted.get("depth_info"):
             yield "depth_info", info
         if wanted.get("points"):
-            xyz = depth_to_points(frame.depth, c)
             data = self._points
             if data is None:  # made once, its padding zero: publish serialises at once, so reuse is safe
                 data = self._points = np.zeros((c.height, c.width), dtype=CAMERA_DTYPE)
-            data["x"], data["y"], data["z"] = xyz[..., 0], xyz[..., 1], xyz[..., 2]
-            rgb = frame.image.astype(np.uint32)
-            if rgb.shape[2] == 1:
-                rgb = np.repeat(rgb, 3, axis=2)
-            data["rgb"] = (rgb[..., 0] << 16) | (rgb[..., 1] << 8) | rgb[..., 2]
+            depth_to_points(frame.depth, c, out=(data["x"], data["y"], data["z"]))
+            if c.channels == 1:  # grey in each of r, g, b
+                data["rgb"] = frame.image[..., 0].astype(np.uint32) * 0x010101
+            else:  # rgb = r << 16 | g << 8 | b: the renderer's RGBA words (little-endian a b g r) swapped, >> 8
+                words = frame.rgba.view("<u4").reshape(c.height, c.width)
+                np.right_shift(words.byteswap(), 8, out=data["rgb"])
             yield "points", self.cloud(stamp, data, CAMERA_FIELDS, dense=False)
 
     _depth = _camera

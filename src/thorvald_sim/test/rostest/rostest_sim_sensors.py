@@ -134,6 +134,21 @@ class SimSensorsTest(SimSensorRatesTest):
         d = np.frombuffer(depth.data, "<f4").reshape(120, 160)
         self.assertEqual(depth.encoding, "32FC1")
         self.assertAlmostEqual(float(d[60, 80]), 2.0, delta=0.02)
+        # the cloud: organised as the image, the centre point 2 m ahead on the optical axis (z forward),
+        # red packed as gazebo_ros's rgb (r << 16 | g << 8 | b)
+        cloud = Latest(ROBOT + "/rgbd/depth/points", PointCloud2).wait()
+        self.assertEqual((cloud.width, cloud.height, cloud.header.frame_id), (160, 120, "thorvald_001/camera_optical"))
+        self.assertEqual([(f.name, f.offset) for f in cloud.fields], [("x", 0), ("y", 4), ("z", 8), ("rgb", 16)])
+        dtype = np.dtype({"names": ["x", "y", "z", "rgb"], "formats": ["<f4", "<f4", "<f4", "<u4"],
+                          "offsets": [0, 4, 8, 16], "itemsize": cloud.point_step})  # fmt: skip
+        points = np.frombuffer(cloud.data, dtype=dtype).reshape(120, 160)
+        c = points[60, 80]
+        self.assertAlmostEqual(float(c["z"]), 2.0, delta=0.02)
+        self.assertLess(abs(float(c["x"])), 0.02)
+        r, g, b = (int(c["rgb"]) >> 16) & 0xFF, (int(c["rgb"]) >> 8) & 0xFF, int(c["rgb"]) & 0xFF
+        self.assertTrue(r > 150 and g < 60 and b < 60, f"centre point's colour {(r, g, b)}")
+        # 0.7 of the box's half width (0.3 m) right of the centre: x = 0.21 m (the optical frame's x is right)
+        self.assertAlmostEqual(float(points[60, int(80 + 0.7 * half)]["x"]), 0.7 * 0.3, delta=0.02)
 
     def test_unknown_plugins_are_logged_and_a_broken_block_refuses_that_sensor_only(self):
         said = self.said

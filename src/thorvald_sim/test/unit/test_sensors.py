@@ -105,6 +105,17 @@ def box(client, half, centre, rgba=(0.5, 0.5, 0.5, 1)):
     return p.createMultiBody(0, shape, visual, centre, physicsClientId=client)
 
 
+def readings(sim, sensor, n):
+    """n readings of sensor as the simulator takes them (after physics steps, when due): {index on the
+    sensor's schedule: reading}."""
+    out = {}
+    while len(out) < n:
+        sim.step()
+        if sensor.due(sim.time):
+            out[sensor.reading] = sensor.read(sim.time)
+    return out
+
+
 def test_a_lidar_reads_the_geometry(world):
     sim, robot = simulation(world, LIDAR.format(stddev=0.01))
     (lidar,) = robot.sensors
@@ -114,7 +125,7 @@ def test_a_lidar_reads_the_geometry(world):
     post = p.createCollisionShape(p.GEOM_CYLINDER, radius=0.1, height=3.0, physicsClientId=world)
     p.createMultiBody(0, post, -1, (2 * math.cos(math.radians(30)), 2 * math.sin(math.radians(30)), 1.5),
                       physicsClientId=world)  # fmt: skip
-    scans = [lidar.read(sim.time).ranges[0] for _ in range(20)]
+    scans = [scan.ranges[0] for scan in readings(sim, lidar, 20).values()]
     ranges = np.mean(scans, axis=0)
     c = lidar.spec.config
     ahead = round((0.0 - c.min_angle) / c.angle_increment)  # beam 540 points straight ahead
@@ -269,6 +280,13 @@ def test_a_camera_sees_a_red_box_where_its_field_of_view_puts_it_and_the_depth_r
     assert frame.depth[h // 2, w // 2] == pytest.approx(2.0, abs=0.02)
     points = depth_to_points(frame.depth, camera.spec.config)
     assert points[h // 2, w // 2, 2] == pytest.approx(2.0, abs=0.02)
+    assert points[h // 2, inside, 0] == pytest.approx(0.7 * 0.3, abs=0.03)  # right of the axis: +x
+    # written into a point cloud's fields instead: the same figures
+    fields = np.zeros((h, w, 8), dtype=np.float32)
+    xyz = (fields[..., 0], fields[..., 1], fields[..., 4])
+    assert depth_to_points(frame.depth, camera.spec.config, out=xyz) is None
+    assert np.array_equal(fields[..., [0, 1, 4]], points, equal_nan=True)
+    assert np.array_equal(frame.rgba[..., :3], frame.image)  # rgb8: the renderer's RGBA without its alpha
 
 
 def test_p3d_reports_its_link_in_the_world(world):
@@ -323,6 +341,48 @@ def test_an_instants_noise_does_not_depend_on_what_was_drawn_before():
     many = InstantNoise(7, "r1", "gps").at(50).standard_normal(100000)
     following = InstantNoise(7, "r1", "gps").at(51).standard_normal(4)
     assert not any(np.array_equal(following, many[i : i + 4]) for i in range(len(many) - 3))
+
+
+def test_a_readings_normals_depend_on_the_reading_alone():
+    # drawn in blocks of readings, but a reading's draws are its own: the same whatever was drawn
+    # before or in which order, different for the next reading and for another sensor
+    n = 720
+    per_block = InstantNoise.BLOCK // n
+    noise = InstantNoise(7, "r1", "lidar")
+    forward = [noise.normals(k, n).copy() for k in range(2 * per_block + 3)]
+    backward = InstantNoise(7, "r1", "lidar")
+    for k in reversed(range(len(forward))):
+        assert np.array_equal(backward.normals(k, n), forward[k])
+    assert not any(np.array_equal(forward[k], forward[k + 1]) for k in range(len(forward) - 1))
+    assert not np.array_equal(InstantNoise(7, "r1", "lidar2").normals(0, n), forward[0])
+    assert not np.array_equal(InstantNoise(8, "r1", "lidar").normals(0, n), forward[0])
+    # they are standard normals, and not the draws at() gives the same instant
+    everything = np.concatenate(forward)
+    assert abs(everything.mean()) < 4 / math.sqrt(everything.size) and everything.std() == pytest.approx(1, abs=0.01)
+    assert not np.array_equal(InstantNoise(7, "r1", "lidar").at(0).standard_normal(n), forward[0])
+
+
+def test_a_scan_is_the_same_whenever_the_lidar_began_to_be_read(world):
+    # two runs of one seed: one reads the lidar from the start, the other only after 0.25 s; the
+    # scans they share (the same readings on the schedule) are the same, noise included
+    sim, robot = simulation(world, LIDAR.format(stddev=0.05), seed=3)
+    box(world, (0.5, 1.0, 1.5), (3.5, 0.0, 1.5))  # something to see, 3 m ahead
+    (lidar,) = robot.sensors
+    early = {k: scan.ranges for k, scan in readings(sim, lidar, 20).items()}
+    client2 = p.connect(p.DIRECT)
+    try:
+        sim2, robot2 = simulation(client2, LIDAR.format(stddev=0.05), seed=3)
+        box(client2, (0.5, 1.0, 1.5), (3.5, 0.0, 1.5))
+        (lidar2,) = robot2.sensors
+        for _ in range(60):
+            sim2.step()
+        late = {k: scan.ranges for k, scan in readings(sim2, lidar2, 5).items()}
+    finally:
+        p.disconnect(client2)
+    assert set(late) < set(early) and np.isfinite(late[min(late)]).sum() > 100
+    for k, ranges in late.items():
+        assert np.array_equal(ranges, early[k], equal_nan=True)
+    assert not np.array_equal(early[min(early)], early[min(early) + 1])  # consecutive scans' noise differs
 
 
 def test_the_same_seed_gives_the_same_scan(world):
