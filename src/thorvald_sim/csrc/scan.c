@@ -3,7 +3,8 @@
  * A planar lidar's 720 rays cost pybullet about 300 us; the Python around them (the beams turned
  * into the world, the hit fractions taken out of rayTestBatch's tuples, the ranges) cost the
  * simulator node another 120 us a scan, most of it the overhead of a dozen small numpy calls on
- * caches the physics step has just flushed. These two loops do the same in a few microseconds.
+ * caches the physics step has just flushed (the noise added to the ranges alone: two of them). These
+ * two loops do the same in a few microseconds.
  * thorvald_sim.sensors uses numpy where this module is not built, with the same results
  * (test_sensors compares them).
  */
@@ -84,21 +85,23 @@ static PyObject *beams(PyObject *self, PyObject *args)
     return PyLong_FromSsize_t(n);
 }
 
-/* ranges(hits, out, range_min, range_max) -> number of rays
- * out[i] = range_min + fraction_i * (range_max - range_min), or inf where fraction_i >= 1 (the ray
- * reached range_max without a hit). out: a writable C-contiguous float64 buffer of at least
- * len(hits) values. */
+/* ranges(hits, out, range_min, range_max, noise=None, stddev=0.0) -> number of rays
+ * rayTestBatch's results (object, link, fraction, position, normal), cast from range_min to
+ * range_max, as ranges into out (float64): inf where the ray hit nothing (fraction 1), else
+ * range_min + fraction (range_max - range_min), plus stddev noise[i] where noise (float64, one per
+ * ray) is given. */
 static PyObject *ranges(PyObject *self, PyObject *args)
 {
-    PyObject *hits, *out, *seq;
-    double range_min, range_max;
-    Py_buffer view;
+    PyObject *hits, *out, *seq, *noise = Py_None;
+    double range_min, range_max, stddev = 0.0;
+    Py_buffer view, noise_view;
     Py_ssize_t n, i;
     PyObject **items;
     double *r, span;
+    const double *z = NULL;
     (void)self;
 
-    if (!PyArg_ParseTuple(args, "OOdd", &hits, &out, &range_min, &range_max))
+    if (!PyArg_ParseTuple(args, "OOdd|Od", &hits, &out, &range_min, &range_max, &noise, &stddev))
         return NULL;
     seq = PySequence_Fast(hits, "ranges: hits must be a sequence of rayTestBatch results");
     if (seq == NULL)
@@ -108,12 +111,20 @@ static PyObject *ranges(PyObject *self, PyObject *args)
         Py_DECREF(seq);
         return NULL;
     }
+    if (noise != Py_None) {
+        if (double_buffer(noise, &noise_view, n, 0, "noise") < 0) {
+            PyBuffer_Release(&view);
+            Py_DECREF(seq);
+            return NULL;
+        }
+        z = (const double *)noise_view.buf;
+    }
     r = (double *)view.buf;
     span = range_max - range_min;
     items = PySequence_Fast_ITEMS(seq);
     for (i = 0; i < n; i++) {
         PyObject *hit = items[i];
-        double f;
+        double f, range;
         if (!PyTuple_Check(hit) || PyTuple_GET_SIZE(hit) < 3) {
             PyErr_Format(PyExc_TypeError, "ranges: result %zd is not a rayTestBatch result", i);
             goto fail;
@@ -121,13 +132,22 @@ static PyObject *ranges(PyObject *self, PyObject *args)
         f = PyFloat_AsDouble(PyTuple_GET_ITEM(hit, 2));
         if (f == -1.0 && PyErr_Occurred())
             goto fail;
-        r[i] = f >= 1.0 ? INFINITY : range_min + f * span;
+        if (f >= 1.0) {
+            r[i] = INFINITY;
+            continue;
+        }
+        range = range_min + f * span;
+        r[i] = z ? range + stddev * z[i] : range;
     }
+    if (z)
+        PyBuffer_Release(&noise_view);
     PyBuffer_Release(&view);
     Py_DECREF(seq);
     return PyLong_FromSsize_t(n);
 
 fail:
+    if (z)
+        PyBuffer_Release(&noise_view);
     PyBuffer_Release(&view);
     Py_DECREF(seq);
     return NULL;
@@ -137,7 +157,8 @@ static PyMethodDef methods[] = {
     {"beams", beams, METH_VARARGS,
      "beams(quaternion, origin, directions, range_min, range_max, starts, ends) -> n: the beams in the world"},
     {"ranges", ranges, METH_VARARGS,
-     "ranges(hits, out, range_min, range_max) -> n: rayTestBatch results to ranges in out (inf: no hit)"},
+     "ranges(hits, out, range_min, range_max, noise=None, stddev=0.0) -> n: rayTestBatch results to ranges in "
+     "out (inf: no hit), plus stddev * noise"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -82,16 +82,30 @@ def beams(pose: Transform, directions: np.ndarray, limits: Tuple[float, float], 
     np.add(origin, d * range_max, out=ends)
 
 
-def ranges_from_hits(hits, out: np.ndarray, limits: Tuple[float, float], *, compiled: bool = True) -> None:
+def ranges_from_hits(
+    hits,
+    out: np.ndarray,
+    limits: Tuple[float, float],
+    noise: Optional[Tuple[float, np.ndarray]] = None,
+    *,
+    compiled: bool = True,
+) -> None:
     """rayTestBatch's results (one per ray, cast from range_min to range_max: limits) as ranges into
-    out: inf for a ray that hit nothing (fraction 1.0; a return at range_max is out of range anyway).
+    out: inf for a ray that hit nothing (fraction 1.0; a return at range_max is out of range anyway),
+    plus stddev z where noise = (stddev, z: one standard normal per ray) is given (inf stays inf).
     compiled: the C loop of ``_scan`` where it is built (the same figures)."""
     range_min, range_max = limits
+    n = len(hits)
     if compiled and _scan is not None:
-        _scan.ranges(hits, out, range_min, range_max)
+        if noise is None:
+            _scan.ranges(hits, out, range_min, range_max)
+        else:
+            _scan.ranges(hits, out, range_min, range_max, noise[1], noise[0])
         return
-    fractions = np.fromiter(map(_FRACTION, hits), float, len(hits))
-    out[: len(hits)] = np.where(fractions >= 1.0, np.inf, range_min + fractions * (range_max - range_min))
+    fractions = np.fromiter(map(_FRACTION, hits), float, n)
+    out[:n] = np.where(fractions >= 1.0, np.inf, range_min + fractions * (range_max - range_min))
+    if noise is not None:
+        out[:n] += noise[0] * noise[1][:n]
 
 
 class MountError(Exception):
@@ -290,11 +304,12 @@ class Lidar(Sensor):
         # pybullet takes the arrays as they are (a list of them costs a fifth of the rays' time)
         beams(self.pose(), self._flat, limits, (starts, ends))
         ranges = np.empty(len(starts))
+        # every beam's noise drawn (inf stays inf): the same draws whatever the beams hit
+        z = self.noise.normals(self.reading, len(ranges)) if c.noise_stddev > 0 else None
         for k in range(0, len(starts), RAY_BATCH):
             hits = p.rayTestBatch(starts[k : k + RAY_BATCH], ends[k : k + RAY_BATCH], physicsClientId=self.client)
-            ranges_from_hits(hits, ranges[k : k + len(hits)], limits)
-        if c.noise_stddev > 0:  # every beam drawn (inf stays inf): the same draws whatever the beams hit
-            ranges += c.noise_stddev * self.noise.normals(self.reading, len(ranges))
+            noise = None if z is None else (c.noise_stddev, z[k : k + len(hits)])
+            ranges_from_hits(hits, ranges[k : k + len(hits)], limits, noise)
         if c.noise_mean != 0:
             ranges += c.noise_mean
         return Scan(ranges.reshape(self.directions.shape[:2]), self.directions)

@@ -450,6 +450,12 @@ def test_the_compiled_beams_and_ranges_are_numpys():
     assert np.array_equal(compiled, numpy)
     assert compiled[0] == -1.0 and compiled[8] == -1.0  # only the slice written
     assert compiled[3] == 0.1 + 0.5 * 29.9 and math.isinf(compiled[5]) and math.isinf(compiled[6])
+    # with noise: stddev z added to every range, inf stays inf
+    z = rng.normal(size=7)
+    ranges_from_hits(hits, compiled[1:8], (0.1, 30.0), (0.05, z))
+    ranges_from_hits(hits, numpy[1:8], (0.1, 30.0), (0.05, z), compiled=False)
+    assert np.array_equal(compiled, numpy)
+    assert compiled[3] == (0.1 + 0.5 * 29.9) + 0.05 * z[2] and math.isinf(compiled[5])
 
 
 def test_the_compiled_loops_refuse_what_they_cannot_read():
@@ -458,6 +464,8 @@ def test_the_compiled_loops_refuse_what_they_cannot_read():
         ranges_from_hits(hits, np.empty(3), (0.1, 30.0))
     with pytest.raises(ValueError, match="float64"):
         ranges_from_hits(hits, np.empty(4, dtype=np.float32), (0.1, 30.0))
+    with pytest.raises(ValueError, match="noise must be C-contiguous float64 with room for 4"):
+        ranges_from_hits(hits, np.empty(4), (0.1, 30.0), (0.05, np.zeros(3)))
     with pytest.raises(TypeError, match="result 1 is not a rayTestBatch result"):
         ranges_from_hits((hits[0], (1, 2)), np.empty(2), (0.1, 30.0))
     directions = np.ones((5, 3))
