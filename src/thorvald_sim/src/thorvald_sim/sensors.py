@@ -422,13 +422,13 @@ class Gnss(Sensor):
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Frame:
-    """A camera frame: the image (height x width x channels, uint8), the renderer's RGBA (height x
-    width x 4, uint8) and, for depth cameras, the depth along the optical axis [m] (float32, NaN
-    outside the point cloud's cutoffs)."""
+    """A camera frame: the image (height x width x channels, uint8), for depth cameras the depth along
+    the optical axis [m] (float32, NaN outside the point cloud's cutoffs), and the renderer's RGBA
+    (height x width x 4, uint8; a cloud's colours come from it)."""
 
     image: np.ndarray
     depth: Optional[np.ndarray]
-    rgba: Optional[np.ndarray] = None
+    rgba: np.ndarray
 
 
 class Camera(Sensor):
@@ -474,7 +474,8 @@ class Camera(Sensor):
 def depth_to_points(depth: np.ndarray, config: CameraConfig, out=None) -> Optional[np.ndarray]:
     """An organised cloud (height x width x 3) in the optical frame (z forward, x right, y down) from a
     depth image, with gazebo_ros's intrinsics (focal length from horizontal_fov, centre (w+1)/2, (h+1)/2).
-    out: (x, y, z) arrays (height x width, e.g. a structured array's fields) to write into instead."""
+    out: (x, y, z) arrays (height x width, e.g. a structured array's fields) to write into instead
+    (then it returns None)."""
     h, w = depth.shape
     f = config.focal_length
     u = (np.arange(w, dtype=np.float32) + 1.0 - (w + 1) / 2.0) / np.float32(f)
