@@ -69,6 +69,14 @@ CAMERA_DTYPE = np.dtype(
 _LENGTH = struct.Struct("<I")  # a ROS array's length
 
 
+def packed_rgb(rgba: np.ndarray, out: Optional[np.ndarray] = None) -> np.ndarray:
+    """The packed colours of RGBA pixels (... x 4, uint8) as a cloud's ``rgb`` field holds them,
+    r << 16 | g << 8 | b (uint32; gazebo_ros's and PCL's layout), into out if given: each pixel's
+    little-endian word (a b g r) byte-swapped and shifted right by 8."""
+    words = np.ascontiguousarray(rgba, dtype=np.uint8).view("<u4")[..., 0]
+    return np.right_shift(words.byteswap(), 8, out=out)
+
+
 class _ArrayFields:
     """A message whose last array fields (``ARRAYS``: name and element type, in order, followed by
     ``TAIL`` bytes of other fields) may be numpy arrays, serialised with their bytes as they are.
@@ -280,9 +288,8 @@ class SensorIO:
             depth_to_points(frame.depth, c, out=(data["x"], data["y"], data["z"]))
             if c.channels == 1:  # grey in each of r, g, b
                 data["rgb"] = frame.image[..., 0].astype(np.uint32) * 0x010101
-            else:  # rgb = r << 16 | g << 8 | b: the renderer's RGBA words (little-endian a b g r) swapped, >> 8
-                words = frame.rgba.view("<u4").reshape(c.height, c.width)
-                np.right_shift(words.byteswap(), 8, out=data["rgb"])
+            else:  # from the renderer's RGBA, whatever the image's channel order
+                packed_rgb(frame.rgba, out=data["rgb"])
             yield "points", self.cloud(stamp, data, CAMERA_FIELDS, dense=False)
 
     _depth = _camera

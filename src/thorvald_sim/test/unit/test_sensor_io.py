@@ -15,6 +15,7 @@ from thorvald_sim.sensor_io import (
     FastImage,
     FastLaserScan,
     FastPointCloud2,
+    packed_rgb,
 )
 
 
@@ -104,3 +105,13 @@ def test_a_fast_point_cloud_serialises_its_points_to_genpys_bytes():
     empty = np.zeros((1, 0), dtype=LIDAR_DTYPE)  # a 3D lidar that sees nothing
     fast = serialised(cloud(FastPointCloud2, empty, LIDAR_FIELDS, (0, 1, 22), True))
     assert fast == serialised(cloud(PointCloud2, b"", LIDAR_FIELDS, (0, 1, 22), True))
+
+
+def test_a_clouds_colours_are_packed_r_g_b_from_the_rgba():
+    rgba = np.array([[[10, 20, 30, 255], [255, 0, 0, 128]], [[0, 0, 255, 0], [1, 2, 3, 4]]], dtype=np.uint8)
+    assert packed_rgb(rgba).tolist() == [[0x0A141E, 0xFF0000], [0x0000FF, 0x010203]]
+    # into a cloud's field (strided, 32 bytes a point): the same words, the rest of the points untouched
+    points = np.zeros((2, 2), dtype=CAMERA_DTYPE)
+    points["x"] = 1.5
+    packed_rgb(rgba, out=points["rgb"])
+    assert points["rgb"].tolist() == [[0x0A141E, 0xFF0000], [0x0000FF, 0x010203]] and (points["x"] == 1.5).all()

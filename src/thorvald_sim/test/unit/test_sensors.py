@@ -289,6 +289,19 @@ def test_a_camera_sees_a_red_box_where_its_field_of_view_puts_it_and_the_depth_r
     assert np.array_equal(frame.rgba[..., :3], frame.image)  # rgb8: the renderer's RGBA without its alpha
 
 
+def test_a_bgr8_camera_orders_its_image_blue_green_red(world):
+    bgr = CAMERA.replace("<height>60</height>", "<height>60</height><format>B8G8R8</format>")
+    sim, robot = simulation(world, bgr)
+    (camera,) = robot.sensors
+    assert camera.spec.config.encoding == "bgr8"
+    box(world, (0.25, 0.3, 0.3), (2.35, 0.0, 1.0), rgba=(1, 0, 0, 1))  # red, 2 m ahead
+    frame = camera.read(sim.time)
+    h, w, _ = frame.image.shape
+    blue, green, red = frame.image[h // 2, w // 2]
+    assert red > 150 and green < 60 and blue < 60
+    assert np.array_equal(frame.image, frame.rgba[..., 2::-1])  # the renderer's RGBA stays RGBA (the cloud's colours)
+
+
 def test_p3d_reports_its_link_in_the_world(world):
     sim, robot = simulation(world, P3D)
     truth = robot.sensors[0].read(sim.time)
