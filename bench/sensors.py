@@ -326,11 +326,18 @@ def robots_part(n: int, seconds: float, port: int, stack: str) -> bool:
     return v1 and v2
 
 
+def _at_least_one(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value}: must be at least 1")
+    return value
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--seconds", type=float, default=10.0, help="simulated seconds measured per case")
     parser.add_argument("--robots", type=int, default=4)
-    parser.add_argument("--rounds", type=int, default=3, help="part 1: rounds per sensor (median kept)")
+    parser.add_argument("--rounds", type=_at_least_one, default=3, help="part 1: rounds per sensor (median kept)")
     parser.add_argument("--part", type=int, choices=(1, 2), help="only this part (default: both)")
     parser.add_argument("--raw", metavar="SENSOR", help=argparse.SUPPRESS)  # RawBeside's worker
     parser.add_argument(
