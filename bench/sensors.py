@@ -267,13 +267,14 @@ def sensors_part(seconds: float, port: int, rounds: int) -> bool:
     phases = [SENSOR_TOPICS[name] if name else "all" for name in beside]
     ratios, raw, node, in_node = {}, {}, {}, {}
     for name, (_, _, cpu, raw_cpu) in zip(beside, node_case(1, seconds, port, phases, beside=beside)):
+        by_name = {key.split(" ", 1)[1]: value for key, value in cpu.items()}  # "<kind> <name>" -> name
         if name:
-            node_cpu = next((v for k, v in cpu.items() if k.split(" ", 1)[1] == name), float("nan"))
+            node_cpu = by_name.get(name, float("nan"))
             raw.setdefault(name, []).append(raw_cpu)
             node.setdefault(name, []).append(node_cpu)
             ratios.setdefault(name, []).append(node_cpu / raw_cpu)
         else:  # the sensors without a raw reference (IMU, GNSS), read with everything
-            in_node = {k.split(" ", 1)[1]: v for k, v in cpu.items() if k.split(" ", 1)[1] not in SENSOR_TOPICS}
+            in_node = {k: v for k, v in by_name.items() if k not in SENSOR_TOPICS}
     alone = raw_costs(2.0)  # the same raw work again, with nothing beside it
     fixed = raw_costs(2.0, fixed=True)  # the lidars' rays from a mount computed once
     print(f"1. each sensor: CPU per simulated second, raw pybullet beside the simulator node (one robot), "

@@ -95,17 +95,15 @@ def ranges_from_hits(
     plus stddev z where noise = (stddev, z: one standard normal per ray) is given (inf stays inf).
     compiled: the C loop of ``_scan`` where it is built (the same figures)."""
     range_min, range_max = limits
-    n = len(hits)
+    stddev, z = noise if noise is not None else (0.0, None)
     if compiled and _scan is not None:
-        if noise is None:
-            _scan.ranges(hits, out, range_min, range_max)
-        else:
-            _scan.ranges(hits, out, range_min, range_max, noise[1], noise[0])
+        _scan.ranges(hits, out, range_min, range_max, z, stddev)
         return
+    n = len(hits)
     fractions = np.fromiter(map(_FRACTION, hits), float, n)
     out[:n] = np.where(fractions >= 1.0, np.inf, range_min + fractions * (range_max - range_min))
-    if noise is not None:
-        out[:n] += noise[0] * noise[1][:n]
+    if z is not None:
+        out[:n] += stddev * z[:n]
 
 
 class MountError(Exception):
