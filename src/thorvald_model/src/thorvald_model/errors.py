@@ -3,6 +3,8 @@
 from dataclasses import dataclass
 from typing import Any, Sequence
 
+from .value_text import value_text
+
 
 class ThorvaldModelError(Exception):
     """Base class of every error this package raises."""
@@ -26,7 +28,8 @@ class Problem:
     rule: str
 
     def format(self, source: str) -> str:
-        value = "<missing>" if self.value is MISSING else repr(self.value)
+        # the value's repr, cut: it may be anything a file or a parameter tree holds, however large
+        value = "<missing>" if self.value is MISSING else value_text(self.value)
         return "{}: {}: {}: {}".format(source, self.path or "<top level>", value, self.rule)
 
 
