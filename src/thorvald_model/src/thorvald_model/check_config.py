@@ -1,17 +1,25 @@
-"""``rosrun thorvald_model check_config FILE [FILE ...]``: validates robot configuration files.
+"""``rosrun thorvald_model check_config FILE [FILE ...] [--model-extras XACRO] [--tf-prefix P]``.
 
-One file: a summary of the robot and its drives. Several files: one table row per robot.
-Invalid files: every problem, one per line, on stderr, and exit status 2.
+Validates robot configuration files. One file: a summary of the robot and its drives. Several
+files: one table row per robot. Invalid files: every problem, one per line, on stderr, and exit
+status 2.
+
+With ``--model-extras`` (a model_extras file, e.g. the user's sensors) or ``--tf-prefix``, the
+robot's URDF is generated as model.launch generates it and checked as check_urdf would
+(:mod:`thorvald_model.urdf_check`): a joint naming a link that does not exist is reported with
+the joint, the link and the closest existing names, as it would stop the robot's launch.
 """
 
 import argparse
-import json
 import math
 import os
 import sys
-from typing import List, Optional
+import xml.etree.ElementTree as ET
+from typing import Dict, List, Optional
 
+from .check_report import report
 from .config import RobotConfig, load_robot_config
+from .description import XacroError, generate_urdf
 from .errors import ConfigError
 
 
@@ -57,6 +65,24 @@ def format_table(rows: List[dict]) -> str:
     return "\n".join(lines)
 
 
+def description_summary(urdf: str, extras: str = "") -> Dict[str, object]:
+    """Links, joints and the root link of a generated (checked) robot description."""
+    root = ET.fromstring(urdf)
+    links = [link.get("name") for link in root.findall("link")]
+    children = {c.get("link") for c in root.findall("joint/child")}
+    return {
+        "links": len(links),
+        "joints": len(root.findall("joint")),
+        "root": next((link for link in links if link not in children), ""),
+        "extras": extras,
+    }
+
+
+def format_description(d: Dict[str, object]) -> str:
+    extras = ", with {}".format(d["extras"]) if d["extras"] else ""
+    return "  description {} links, {} joints, root {}{}".format(d["links"], d["joints"], d["root"], extras)
+
+
 def format_details(config: RobotConfig) -> str:
     s = summary(config)
     lines = [
@@ -97,30 +123,49 @@ def main(argv: Optional[List[str]] = None) -> int:
     )
     parser.add_argument("files", nargs="+", metavar="FILE", help="robot configuration YAML file(s)")
     parser.add_argument("--json", action="store_true", help="print the summaries as JSON")
+    parser.add_argument(
+        "--model-extras",
+        default="",
+        metavar="XACRO",
+        help="generate each robot's URDF with this model_extras file and check it as check_urdf would",
+    )
+    parser.add_argument(
+        "--tf-prefix", default=None, help='tf_prefix of the generated URDF, e.g. "robot_1/" (generates and checks it)'
+    )
     args = parser.parse_args(argv)
+    describe = bool(args.model_extras) or args.tf_prefix is not None
 
-    configs, failed = [], 0
+    configs, descriptions, failed = [], {}, 0
     for path in args.files:
         try:
             config = load_robot_config(path)
             problems = calculator_problems(config)
             if problems:
                 raise ConfigError(path, problems)
+            if describe:
+                urdf = generate_urdf(path, tf_prefix=args.tf_prefix or "", model_extras=args.model_extras)
+                descriptions[config.source] = description_summary(urdf, args.model_extras)
             configs.append(config)
-        except ConfigError as e:
+        except ConfigError as e:  # the robot file's problems, or the generated description's (UrdfCheckError)
             failed += 1
             print(e, file=sys.stderr)
-    if args.json:
-        print(json.dumps([summary(c) for c in configs], indent=2))
-    elif len(args.files) == 1 and configs:
-        print(format_details(configs[0]))
-    elif configs:
-        print(format_table([summary(c) for c in configs]))
-    if failed:
-        if len(args.files) > 1:
-            print(f"{failed} of {len(args.files)} file(s) invalid", file=sys.stderr)
-        return 2
-    return 0
+        except XacroError as e:  # e.g. an extras file that is missing or not XML
+            failed += 1
+            print(f"check_config: error: {path}: {e}", file=sys.stderr)
+
+    def row(config: RobotConfig) -> dict:
+        out = summary(config)
+        if config.source in descriptions:
+            out["description"] = descriptions[config.source]
+        return out
+
+    def details(config: RobotConfig) -> str:
+        text = format_details(config)
+        if config.source in descriptions:
+            text += "\n" + format_description(descriptions[config.source])
+        return text
+
+    return report(configs, failed, len(args.files), as_json=args.json, row=row, details=details, table=format_table)
 
 
 if __name__ == "__main__":

@@ -10,6 +10,12 @@ file stops with the loader's list of problems. The xacro never repeats a default
 Other YAML files (a user's extras loading their sensor table) load with ``yaml.safe_load``, since
 xacro 1.13's own ``load_yaml`` calls ``yaml.load`` without a Loader, which PyYAML 6 rejects.
 
+The generated description is then normalised and checked as check_urdf would
+(:mod:`thorvald_model.urdf_check`): a link reference written ``/base_link`` (older generators) or
+``thorvald_001//base_link`` (the two tf_prefix conventions mixed) means ``base_link`` /
+``thorvald_001/base_link``, as in tf2, and a broken tree (a joint naming a link that does not exist)
+stops with every problem (:class:`~thorvald_model.urdf_check.UrdfCheckError`) before anything runs.
+
 Pure: no rospy, no messages. ``$(find pkg)`` in a user's extras resolves through rospack.
 """
 
@@ -27,6 +33,7 @@ from .datum import load_datum
 from .errors import ConfigError, ThorvaldModelError
 from .frames import normalize_tf_prefix
 from .resources import package_folder
+from .urdf_check import UrdfCheckError, normalize_document, urdf_problems
 
 # The package folder when this module runs from the source tree (or the devel space, which relays
 # to it); in an install space the package's files are under share/thorvald_model instead.
@@ -171,8 +178,9 @@ def generate_urdf(
 ) -> str:
     """The URDF of the robot described by the configuration file robot_config.
 
-    Raises ConfigError (every problem of the file) or XacroError (e.g. an extras file that is
-    missing or broken).
+    Raises ConfigError (every problem of the file), UrdfCheckError (a ConfigError: every problem of
+    the robot's tree, e.g. an extras' joint naming a link that does not exist; named after the extras
+    file when there is one) or XacroError (e.g. an extras file that is missing or broken).
     """
     mappings = xacro_args(robot_config, tf_prefix, model_extras, robot_name, datum_file)
     try:
@@ -186,7 +194,21 @@ def generate_urdf(
         raise XacroError(f"{type(e).__name__}: {e}") from None
     finally:
         xacro.substitution_args_context["arg"] = {}
+    check_document(doc, mappings["model_extras"] or mappings["robot_config"])
     return doc.toprettyxml(indent="  ")
+
+
+def check_document(doc: Any, source: str) -> None:
+    """Normalises the link references of xacro's result (a ``xml.dom.minidom`` document) in place,
+    keeping its formatting, and checks it as check_urdf would; UrdfCheckError naming source with
+    every problem. A document that is not a ``<robot>`` (xacro makes other files too) is left alone."""
+    root = doc.documentElement
+    if root is None or root.tagName != "robot":
+        return
+    normalize_document(doc)
+    problems = urdf_problems(doc.toxml())
+    if problems:
+        raise UrdfCheckError(source, problems)
 
 
 def _xacro_message(e: Exception) -> str:

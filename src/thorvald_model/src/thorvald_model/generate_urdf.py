@@ -1,7 +1,10 @@
 """``rosrun thorvald_model generate_urdf CONFIG [--tf-prefix P] [--extras X] [--robot-name N]``.
 
 Prints the URDF of the robot a configuration file describes (or writes it with ``-o``). A broken
-configuration prints the shared loader's problems, one per line, and exits 2.
+configuration prints the shared loader's problems, one per line, and exits 2; so does a robot whose
+tree check_urdf would refuse (e.g. an extras joint naming a link that does not exist: the joint, the
+link and the closest existing names), and nothing is written. Link references written with a
+leading slash (``/base_link``) are the robot's links (:mod:`thorvald_model.urdf_check`).
 """
 
 import argparse

@@ -17,6 +17,7 @@ from thorvald_model.datum import Datum, parse_datum
 from thorvald_model.errors import ConfigError
 from thorvald_model.joint_tree import Origin, ParentJoint, UrdfError  # noqa: F401  (Origin: for the sensors)
 from thorvald_model.joint_tree import link_tree as _link_tree
+from thorvald_model.urdf_check import normalize_frame
 
 
 class DescriptionError(Exception):
@@ -151,8 +152,9 @@ def parse_description(xml: str) -> RobotDescription:
         tuple(springs),
         plugin.findtext("commandTopic") or "base_state",
         plugin.findtext("odometryTopic") or "odometry/gazebo",
-        plugin.findtext("odometryFrame") or "odom",
-        plugin.findtext("robotBaseFrame") or "base_link",
+        # frames as tf2 reads them: an older generator's /base_link is base_link
+        normalize_frame(plugin.findtext("odometryFrame") or "odom"),
+        normalize_frame(plugin.findtext("robotBaseFrame") or "base_link"),
         _datum(plugin.find("datum")),
     )
 

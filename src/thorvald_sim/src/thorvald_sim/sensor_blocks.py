@@ -39,6 +39,7 @@ from typing import Dict, List, Optional, Tuple
 
 from thorvald_model.datum import Datum
 from thorvald_model.joint_tree import Origin as Pose  # a transform: SDF's <pose> is URDF's <origin>
+from thorvald_model.urdf_check import normalize_frame
 
 Vec3 = Tuple[float, float, float]
 
@@ -630,6 +631,8 @@ def read_sensor_blocks(xml: str) -> SensorBlocks:
             except BlockError as e:
                 refused.append(Refused("", e.path, e.rule))
                 continue
+            # bodyName is a link as tf2 reads it (/base_link is base_link), as the spawned description's are
+            spec = replace(spec, link=normalize_frame(spec.link), child_frame=normalize_frame(spec.child_frame))
             if spec.link not in links:
                 refused.append(Refused("", f"{path}/bodyName", f"{spec.link!r}: no such link in the description"))
                 continue
@@ -657,14 +660,17 @@ def resolve_frame(spec: SensorSpec, tf_prefix: str, namespace: str) -> str:
     So a frameName of ``hokuyo`` in robot ``thorvald_001`` is ``thorvald_001/hokuyo``; write
     ``/thorvald_001/hokuyo`` for a name to be kept as it is. FRAME_NAMESPACE_FIRST (velodyne): the
     same with the namespace before tf_prefix. FRAME_AS_IS (imu_sensor, imu, hector gps): as written.
+    In every case as tf2 reads it (:func:`~thorvald_model.urdf_check.normalize_frame`): no leading
+    slash (``/imu_link`` is ``imu_link``), no doubled one (a tf_prefix ``thorvald_001/`` joined with a
+    slash), so the frame is the link robot_state_publisher publishes.
     """
     if spec.frame_rule == FRAME_AS_IS:
-        return spec.frame
+        return normalize_frame(spec.frame)
     if spec.frame_rule == FRAME_NAMESPACE_FIRST:  # velodyne_gazebo_plugins: the namespace wins over tf_prefix
         prefix = namespace.strip("/") or tf_prefix
     else:
         prefix = tf_prefix if tf_prefix else namespace.strip("/")
-    return tf_resolve(prefix, spec.frame)
+    return normalize_frame(tf_resolve(prefix, spec.frame))
 
 
 def resolve_topic(spec: SensorSpec, role: str, namespace: str) -> str:

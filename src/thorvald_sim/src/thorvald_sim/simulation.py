@@ -11,6 +11,8 @@ from typing import Dict, Optional, Tuple
 import numpy as np
 import pybullet as p
 
+from thorvald_model.urdf_check import UrdfCheckError, checked_urdf
+
 from .as_built import SimAsBuilt
 from .description import DescriptionError, MeshFinder, mesh_finder, parse_description, resolve_meshes
 from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
@@ -88,11 +90,22 @@ class Simulation:
         simulated and what is refused is in ``sensor_blocks`` and ``sensor_problems``, for the
         caller to say so too. The robot spawns whatever its sensor blocks hold. as_built: the robot
         as built (:mod:`thorvald_sim.as_built`), None for as configured.
+
+        The description may come from any generator (``spawn_robot -file``): before pybullet sees it,
+        its link references are read as tf2 reads them (``/base_link`` is ``base_link``,
+        ``thorvald_001//base_link`` is ``thorvald_001/base_link``) and it is checked as check_urdf
+        would (:mod:`thorvald_model.urdf_check`), so a broken tree is refused naming each joint, the
+        link that does not exist and the closest existing names, not with pybullet's "Cannot load URDF
+        file.".
         """
         if not name:
             raise SpawnError("a robot needs a name")
         if name in self.robots:
             raise SpawnError(f"a robot named {name!r} exists already")
+        try:
+            urdf = checked_urdf(urdf, name)
+        except UrdfCheckError as e:
+            raise SpawnError(str(e)) from None  # "NAME: invalid robot description (...)", each line naming NAME
         try:
             description = parse_description(urdf)
             urdf, missing = resolve_meshes(urdf, self.find_mesh)
