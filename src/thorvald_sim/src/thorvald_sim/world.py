@@ -8,6 +8,8 @@ this package's ``worlds`` folder) or gives a path. A world file has these top-le
 multiplies with the wheel's; the simulator's wheels have friction 1.0). Defaults in brackets; a key
 without one is required. Every section's entries are numbered from 0 without gaps (``object0``, ``object1``, ...).
 A colour, ``rgba``, is a list of 3 or 4 numbers in [0, 1] (red, green, blue and alpha, 1 if left out).
+``rosrun thorvald_sim check_world FILE [FILE ...]`` (:mod:`thorvald_sim.check_world`) checks world
+files, or shipped worlds by name, as the simulator loads them, without starting it.
 
 ``gravity``
     [m/s^2] (9.81).
@@ -37,7 +39,8 @@ A colour, ``rgba``, is a list of 3 or 4 numbers in [0, 1] (red, green, blue and 
 ``objects``
     ``object0``, ...: single bodies. ``shape``: ``box`` (``size_x``, ``size_y``, ``size_z``),
     ``cylinder`` (``radius``, ``length`` along its own z), ``sphere`` (``radius``) or ``mesh``
-    (``file``: an OBJ or STL file, a relative path from the world file's folder; ``scale`` (1)).
+    (``file``: an OBJ or binary STL file, a relative path from the world file's folder, read at
+    load to check it is a mesh (:mod:`thorvald_sim.mesh_check`); ``scale`` (1)).
     ``x``, ``y``; ``z``: of the centre (a mesh's origin) above the ground under it (default: resting
     upright on it, half its height up; a mesh's origin on it); ``roll``, ``pitch``, ``yaw`` (0).
     ``mass`` (0: static; above 0 it falls, slides and can be pushed, without drag as the robots);
@@ -52,7 +55,7 @@ A colour, ``rgba``, is a list of 3 or 4 numbers in [0, 1] (red, green, blue and 
     ``gap_probability`` (alias ``gaps``; 0), and moved by up to ``jitter`` (0) along and across its
     row, from a random generator seeded by ``seed`` (0): the same numbers give the same plants.
     Plants stand on the ground under them (hills and height fields too). ``rgba`` (leaf green);
-    frictions (0.5, 0, 0). At most 100 000 plants an entry.
+    frictions (0.5, 0, 0). The plants of every entry count against the world's budget (Limits).
 ``polytunnels``
     ``polytunnel0``, ...: a Haygrove-type tunnel on level ground (its floor is the ground height at
     its centre): ``x``, ``y`` the centre of the floor, ``yaw`` (0) the direction it runs in,
@@ -83,8 +86,8 @@ A colour, ``rgba``, is a list of 3 or 4 numbers in [0, 1] (red, green, blue and 
     field's x axis ``rut_depth`` (0) deep, ``rut_width`` (0.3) wide, every ``rut_spacing`` (1.5)
     across (the field's centre line is half-way between two ruts). Within ``flat_radius`` (2) of the
     origin, where robots spawn at z = 0 by default, the field is 0 (its grid points out to one
-    cell's diagonal more), rising to full height over the next metre. At most 1 000 000 grid
-    points. Patches, hills and rails stay at z = 0.
+    cell's diagonal more), rising to full height over the next metre. Its grid points (an image's
+    pixels) and noise lattice count against budgets (Limits). Patches, hills and rails stay at z = 0.
 ``description``
     free text.
 
@@ -147,13 +150,52 @@ quite (see :mod:`thorvald_sim.scene`).
 Validation is the robot configuration's (:mod:`thorvald_model.schema`): every problem is collected
 with its dotted key path, value and rule, and raised together in one :class:`ConfigError`. Beyond
 each key's own rule: a rail's radius below its height and its gauge above two radii; an object has
-its shape's dimensions and no other shape's, and its mesh file exists; a sphere plant's height is
+its shape's dimensions and no other shape's, and its mesh file exists and is a mesh pybullet can
+load (:mod:`thorvald_sim.mesh_check`: no junk, no STL without triangles or ASCII STL, no OBJ
+without faces or with faces naming missing vertices); a sphere plant's height is
 at least its radius; a tunnel's height is above its leg height, its end gaps leave the tables a
 length, its tables leave aisles between them (``tables * table_width < width``) and its plants
 stay under its roof; a height field with an image takes no ``resolution``, one without takes no
 ``min_height`` or ``max_height``, its ``max_height`` is above its ``min_height`` and its
 ``rut_width`` at most its ``rut_spacing``; a soft patch lies within 999 m of the origin in x and y;
 neither the ground nor a patch is soft in a world with a height field.
+
+Limits. A world is checked against these budgets at load, from its numbers, before anything they
+count is made (an image's size is read from its header, a mesh file's from the file system), so a
+typing mistake or a hostile file is refused at once with the key to change, not by exhausting the
+memory or hanging the loader. A budget over several entries names the entry that takes the most.
+Figures measured with pybullet 3.2.7, one core:
+
+- positions: ``x``, ``y`` (and an object's ``z``) in [-10 000, 10 000] m: a farm is at most 20 km
+  across, and pybullet draws and its cameras see in single precision, 1 mm steps out there;
+- lengths: every length, size, width, height, radius, spacing, thickness, gap, depth, jitter,
+  amplitude and resolution at most 10 000 m (``min_height`` and ``max_height`` in [-10 000,
+  10 000]); a mesh's ``scale`` at most 1000. So every count made from them is a finite number;
+- plants: 50 000 over every rows entry (places, gaps included: each draws its random numbers) and
+  every polytunnel (strawberries): a plant is a part of a triangle mesh of 32 to 42 vertices,
+  50 000 sphere plants take pybullet 2.6 GB and 14 s to build, cylinders 1.5 GB and 6 s (a
+  hectare of lettuce, rows 0.75 m apart and a plant every 0.35 m, is 38 000);
+- hoops: 2000 over every polytunnel (432 mesh vertices a hoop: 0.7 GB, 2.8 s; 4 km of tunnel);
+- pairs of table legs: 10 000 over every polytunnel (48 mesh vertices a pair);
+- pybullet bodies: 2000 (one a patch, hill, object, wall and row, two a rail, three a polytunnel
+  and three each of its tables, and the ground): pybullet loops over its bodies every step
+  (10 000 static boxes took 6.5 s to build and 17 ms a step, slower than real time);
+- holes: 50 patches in a world with a soft patch (each patch is a hole in the ground; overlapping
+  holes cut it into pieces that grow as the cube of their number: 50 into 7000 pieces, 2.6 s to
+  build; 100 into 21 000, 10 s);
+- ground look-ups: 2 000 000; every plant of a row, every point along a wall (every 0.5 m),
+  every object and every polytunnel looks for the ground under it among the height field (or the
+  plane), every hill and every patch: points times (1 + hills + patches); at the limit 1.6 s of
+  loading on the plane, 5.5 s on a height field (99 walls of 10 km);
+- a height field's grid points, or its image's pixels: 1 000 000 (2 GB and 5 s in pybullet), its
+  image file 32 MB (a 1000 x 1000 16-bit grey PNG is at most 2 MB); its noise lattice
+  (``size / feature_length`` along each side, with an ``amplitude``): 1 000 000 points;
+- mesh files: 32 MB over every object (each object counts its file: pybullet loads it for each);
+  checking them takes up to 3 s, loading them 3 to 6 s and 0.6 to 1.4 GB.
+
+A world at every limit at once would need them together, about 7 GB and a minute to build; each
+limit alone leaves room for the largest fields and greenhouses a robot drives in. The shipped
+worlds use 5 % of a budget at most (crop_rows' 2471 plants), but for farm_track's 6 holes of 50.
 
 Pure: no pybullet, no rospy, no messages (the scene is built by :mod:`thorvald_sim.scene`); the
 plants' positions, the tunnels' geometry and the heights of the ground are computed here, so tests
@@ -165,6 +207,7 @@ import glob
 import math
 import os
 import random
+import warnings
 from dataclasses import dataclass, field, replace
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
@@ -182,6 +225,8 @@ from thorvald_model.schema import (
     parse_section,
     read_yaml_file,
 )
+
+from .mesh_check import mesh_problem
 
 WHAT = "world"
 
@@ -202,8 +247,24 @@ TABLE_DEPTH = 0.2  # [m] of a table-top's trough, below table_height
 STRAWBERRY_RADIUS = 0.3  # of table_width: the foliage balls on a table or bed
 ARCH_SEGMENTS = 16  # straight tubes of a hoop's arch (even: the ridge is a joint)
 FLAT_BLEND = 1.0  # [m] over which a height field rises from its flat disc to full height
-MAX_PLANTS = 100_000  # per rows entry: a typing mistake in plant_spacing must not eat the memory
-MAX_FIELD_POINTS = 1_000_000  # of a height field's grid
+
+# Budgets of a world, checked at load before anything is made (the module's "Limits"): a typing
+# mistake or a hostile file must be refused at once, not exhaust the memory or hang the loader. The
+# figures in brackets were measured with pybullet 3.2.7 on one core.
+MAX_REACH = 10_000.0  # [m] |x|, |y| of anything, and an object's |z|: a farm is at most 20 km across
+MAX_LENGTH = 10_000.0  # [m] of any length, size, height or spacing
+MAX_MESH_SCALE = 1000.0  # [-] a mesh drawn in km, or a scale typed in mm instead of m, is a mistake
+MAX_PLANTS = 50_000  # over every rows and polytunnels entry (sphere plants: 2.6 GB, 14 s to build)
+MAX_HOOPS = 2_000  # over every polytunnel (432 mesh vertices a hoop: 0.7 GB, 2.8 s)
+MAX_TABLE_LEGS = 10_000  # pairs of table legs over every polytunnel (48 mesh vertices a pair)
+MAX_BODIES = 2_000  # pybullet bodies (10 000 static boxes: 6.5 s to build, 17 ms a step)
+MAX_HOLES = 50  # patches in a world with a soft one (50 overlapping: 7000 ground pieces, 2.6 s)
+MAX_GROUND_LOOKUPS = 2_000_000  # points looking for the ground times what they search (1.6 to 5.5 s)
+MAX_FIELD_POINTS = 1_000_000  # of a height field's grid, or pixels of its image (2 GB, 5 s)
+MAX_NOISE_POINTS = 1_000_000  # of a height field's noise lattice (80 MB, 0.2 s)
+MAX_IMAGE_BYTES = 32_000_000  # of a height field's image file (a 1000 x 1000 16-bit PNG is at most 2 MB)
+MAX_MESH_BYTES = 32_000_000  # of the mesh files over every object (3 s to check; 0.6 to 1.4 GB in pybullet)
+WALL_STEP = 0.5  # [m] between the points where a wall looks for the ground under it
 
 SINKAGE_LOAD = 500.0  # [N] on a wheel: the load a surface's sinkage is given for (a 200 kg robot on 4 wheels)
 SINKAGE_MASS = SINKAGE_LOAD / 9.81  # [kg] the reference load's mass, critically damped
@@ -501,8 +562,11 @@ class Polytunnel:
         """v [m] of each table's (or bed's) centre line."""
         if self.crop == "none":
             return ()
-        pitch = self.width / self.tables
-        return tuple(-self.width / 2 + pitch * (i + 0.5) for i in range(self.tables))
+        return tuple(self.table_offset(i) for i in range(self.tables))
+
+    def table_offset(self, i: int) -> float:
+        """v [m] of table i's centre line (0 the rightmost, at -v)."""
+        return -self.width / 2 + self.width / self.tables * (i + 0.5)
 
     def table_span(self) -> Tuple[float, float]:
         """u [m] of the tables' ends."""
@@ -889,7 +953,14 @@ def _frictions(lateral: float) -> Tuple[Key, ...]:
 
 
 UNIT_RANGE = dict(check=in_range(0.0, 1.0), rule="must be in [0, 1]")
-OPTIONAL_POSITIVE = dict(default=None, **POSITIVE)  # a key a cross-field rule requires or refuses
+
+# Every length and position is bounded (MAX_LENGTH, MAX_REACH): the numbers made from them (plants,
+# hoops, grid points) are then finite floats, and a count is checked before anything is made.
+LENGTH = dict(check=lambda v: 0.0 < v <= MAX_LENGTH, rule=f"must be in (0, {MAX_LENGTH:g}] [m]")
+LENGTH_OR_ZERO = dict(check=in_range(0.0, MAX_LENGTH), rule=f"must be in [0, {MAX_LENGTH:g}] [m]")
+HEIGHT = dict(check=in_range(-MAX_LENGTH, MAX_LENGTH), rule=f"must be in [-{MAX_LENGTH:g}, {MAX_LENGTH:g}] [m]")
+COORDINATE = dict(check=in_range(-MAX_REACH, MAX_REACH), rule=f"must be in [-{MAX_REACH:g}, {MAX_REACH:g}] [m]")
+OPTIONAL_LENGTH = dict(default=None, **LENGTH)  # a key a cross-field rule requires or refuses
 
 KINDS_RULE = "must be one of " + ", ".join(SURFACE_KINDS)
 SINKAGE_RULE = f"must be in [0, {MAX_SINKAGE}] [m]"
@@ -910,10 +981,10 @@ GROUND_KEYS = (*SURFACE_KEYS, Key("restitution", float, 0.0, **UNIT_RANGE), RGBA
 GROUND_DEFAULTS = {**SURFACE_DEFAULTS, "lateral_friction": 0.9}
 
 PATCH_KEYS = (
-    Key("x", float),
-    Key("y", float),
-    Key("size_x", float, **POSITIVE),
-    Key("size_y", float, **POSITIVE),
+    Key("x", float, **COORDINATE),
+    Key("y", float, **COORDINATE),
+    Key("size_x", float, **LENGTH),
+    Key("size_y", float, **LENGTH),
     Key("yaw", float, 0.0),
     *SURFACE_KEYS,
     RGBA_KEY,
@@ -922,24 +993,24 @@ PATCH_KEYS = (
 MAX_SLOPE_ANGLE = 1.2  # [rad], about 69 degrees: steeper is a wall, and tan() grows without bound
 
 SLOPE_KEYS = (
-    Key("x", float),
-    Key("y", float),
+    Key("x", float, **COORDINATE),
+    Key("y", float, **COORDINATE),
     Key("yaw", float, 0.0),
-    Key("width", float, **POSITIVE),
+    Key("width", float, **LENGTH),
     Key("angle", float, check=lambda v: 0.0 < v <= MAX_SLOPE_ANGLE, rule=f"must be in (0, {MAX_SLOPE_ANGLE}] [rad]"),
-    Key("height", float, **POSITIVE),
-    Key("top_length", float, 0.0, **NON_NEGATIVE),
+    Key("height", float, **LENGTH),
+    Key("top_length", float, 0.0, **LENGTH_OR_ZERO),
     *_frictions(0.9),
 )
 
 RAIL_KEYS = (
-    Key("x", float),
-    Key("y", float),
+    Key("x", float, **COORDINATE),
+    Key("y", float, **COORDINATE),
     Key("yaw", float, 0.0),
-    Key("length", float, **POSITIVE),
-    Key("gauge", float, 0.55, **POSITIVE),
-    Key("height", float, 0.1, **POSITIVE),
-    Key("radius", float, 0.0255, **POSITIVE),  # 51 mm pipes, the common greenhouse size
+    Key("length", float, **LENGTH),
+    Key("gauge", float, 0.55, **LENGTH),
+    Key("height", float, 0.1, **LENGTH),
+    Key("radius", float, 0.0255, **LENGTH),  # 51 mm pipes, the common greenhouse size
     *_frictions(0.8),
 )
 
@@ -955,19 +1026,19 @@ MESH_EXTENSIONS = (".obj", ".stl")
 
 OBJECT_KEYS = (
     Key("shape", str, check=one_of(*SHAPES), rule="must be one of " + ", ".join(SHAPES)),
-    Key("x", float),
-    Key("y", float),
-    Key("z", float, None),
+    Key("x", float, **COORDINATE),
+    Key("y", float, **COORDINATE),
+    Key("z", float, None, **COORDINATE),
     Key("roll", float, 0.0),
     Key("pitch", float, 0.0),
     Key("yaw", float, 0.0),
-    Key("size_x", float, **OPTIONAL_POSITIVE),
-    Key("size_y", float, **OPTIONAL_POSITIVE),
-    Key("size_z", float, **OPTIONAL_POSITIVE),
-    Key("radius", float, **OPTIONAL_POSITIVE),
-    Key("length", float, **OPTIONAL_POSITIVE),
+    Key("size_x", float, **OPTIONAL_LENGTH),
+    Key("size_y", float, **OPTIONAL_LENGTH),
+    Key("size_z", float, **OPTIONAL_LENGTH),
+    Key("radius", float, **OPTIONAL_LENGTH),
+    Key("length", float, **OPTIONAL_LENGTH),
     Key("file", str, None, check=bool, rule="must not be empty"),
-    Key("scale", float, **OPTIONAL_POSITIVE),
+    Key("scale", float, None, check=lambda v: 0.0 < v <= MAX_MESH_SCALE, rule=f"must be in (0, {MAX_MESH_SCALE:g}]"),
     Key("mass", float, 0.0, **NON_NEGATIVE),
     RGBA_KEY,
     *_frictions(0.8),
@@ -977,18 +1048,18 @@ OBJECT_KEYS = (
 PLANTS = ("cylinder", "sphere")
 
 ROWS_KEYS = (
-    Key("x", float),
-    Key("y", float),
+    Key("x", float, **COORDINATE),
+    Key("y", float, **COORDINATE),
     Key("yaw", float, 0.0),
     Key("count", int, 1, **POSITIVE),
-    Key("spacing", float, 0.75, **POSITIVE),
-    Key("length", float, **POSITIVE),
+    Key("spacing", float, 0.75, **LENGTH),
+    Key("length", float, **LENGTH),
     Key("plant", str, "cylinder", one_of(*PLANTS), "must be one of " + ", ".join(PLANTS)),
-    Key("plant_spacing", float, 0.3, **POSITIVE),
-    Key("plant_radius", float, 0.1, **POSITIVE),
-    Key("plant_height", float, 0.4, **POSITIVE),
+    Key("plant_spacing", float, 0.3, **LENGTH),
+    Key("plant_radius", float, 0.1, **LENGTH),
+    Key("plant_height", float, 0.4, **LENGTH),
     Key("gap_probability", float, 0.0, aliases=("gaps",), **UNIT_RANGE),
-    Key("jitter", float, 0.0, **NON_NEGATIVE),
+    Key("jitter", float, 0.0, **LENGTH_OR_ZERO),
     Key("seed", int, 0),
     RGBA_KEY,
     *_frictions(0.5),
@@ -997,53 +1068,59 @@ ROWS_KEYS = (
 CROPS = ("table_tops", "ground_beds", "none")
 
 POLYTUNNEL_KEYS = (
-    Key("x", float),
-    Key("y", float),
+    Key("x", float, **COORDINATE),
+    Key("y", float, **COORDINATE),
     Key("yaw", float, 0.0),
-    Key("length", float, **POSITIVE),
-    Key("width", float, 8.0, **POSITIVE),
-    Key("height", float, 4.0, **POSITIVE),
-    Key("leg_height", float, 2.0, **NON_NEGATIVE),
-    Key("hoop_spacing", float, 2.0, **POSITIVE),
-    Key("tube", float, 0.05, **POSITIVE),
+    Key("length", float, **LENGTH),
+    Key("width", float, 8.0, **LENGTH),
+    Key("height", float, 4.0, **LENGTH),
+    Key("leg_height", float, 2.0, **LENGTH_OR_ZERO),
+    Key("hoop_spacing", float, 2.0, **LENGTH),
+    Key("tube", float, 0.05, **LENGTH),
     Key("crop", str, "table_tops", one_of(*CROPS), "must be one of " + ", ".join(CROPS)),
     Key("tables", int, 4, **POSITIVE),
-    Key("table_height", float, 1.1, check=lambda v: v > TABLE_DEPTH, rule=f"must be > {TABLE_DEPTH} (the trough)"),
-    Key("table_width", float, 0.4, **POSITIVE),
-    Key("leg_spacing", float, 1.8, **POSITIVE),
-    Key("bed_height", float, 0.2, **POSITIVE),
-    Key("end_gap", float, 1.5, **NON_NEGATIVE),
-    Key("plant_spacing", float, 0.25, **POSITIVE),
+    Key(
+        "table_height",
+        float,
+        1.1,
+        check=lambda v: TABLE_DEPTH < v <= MAX_LENGTH,
+        rule=f"must be in ({TABLE_DEPTH}, {MAX_LENGTH:g}] [m] (above the trough's depth)",
+    ),
+    Key("table_width", float, 0.4, **LENGTH),
+    Key("leg_spacing", float, 1.8, **LENGTH),
+    Key("bed_height", float, 0.2, **LENGTH),
+    Key("end_gap", float, 1.5, **LENGTH_OR_ZERO),
+    Key("plant_spacing", float, 0.25, **LENGTH),
     *_frictions(0.5),
 )
 
 WALL_KEYS = (
-    Key("x", float),
-    Key("y", float),
+    Key("x", float, **COORDINATE),
+    Key("y", float, **COORDINATE),
     Key("yaw", float, 0.0),
-    Key("length", float, **POSITIVE),
-    Key("height", float, 2.0, **POSITIVE),
-    Key("thickness", float, 0.2, **POSITIVE),
+    Key("length", float, **LENGTH),
+    Key("height", float, 2.0, **LENGTH),
+    Key("thickness", float, 0.2, **LENGTH),
     RGBA_KEY,
     *_frictions(0.8),
 )
 
 HEIGHT_FIELD_KEYS = (
-    Key("x", float, 0.0),
-    Key("y", float, 0.0),
-    Key("size_x", float, **POSITIVE),
-    Key("size_y", float, **POSITIVE),
-    Key("resolution", float, **OPTIONAL_POSITIVE),
+    Key("x", float, 0.0, **COORDINATE),
+    Key("y", float, 0.0, **COORDINATE),
+    Key("size_x", float, **LENGTH),
+    Key("size_y", float, **LENGTH),
+    Key("resolution", float, **OPTIONAL_LENGTH),
     Key("image", str, None, check=bool, rule="must not be empty"),
-    Key("min_height", float, None),
-    Key("max_height", float, None),
-    Key("amplitude", float, 0.0, **NON_NEGATIVE),
-    Key("feature_length", float, 1.0, **POSITIVE),
+    Key("min_height", float, None, **HEIGHT),
+    Key("max_height", float, None, **HEIGHT),
+    Key("amplitude", float, 0.0, **LENGTH_OR_ZERO),
+    Key("feature_length", float, 1.0, **LENGTH),
     Key("seed", int, 0),
-    Key("rut_depth", float, 0.0, **NON_NEGATIVE),
-    Key("rut_width", float, 0.3, **POSITIVE),
-    Key("rut_spacing", float, 1.5, **POSITIVE),
-    Key("flat_radius", float, 2.0, **NON_NEGATIVE),
+    Key("rut_depth", float, 0.0, **LENGTH_OR_ZERO),
+    Key("rut_width", float, 0.3, **LENGTH),
+    Key("rut_spacing", float, 1.5, **LENGTH),
+    Key("flat_radius", float, 2.0, **LENGTH_OR_ZERO),
 )
 
 # (top-level key, entry prefix, keys); built in this order, the scene too
@@ -1121,18 +1198,24 @@ def parse_world(data: Any, source: str = "<world>", base_dir: Optional[str] = No
     rails = tuple(_rail(name, index, v) for name, index, v, _ in entries["rails"])
     problems.extend(_rail_problems(rails, problems))
 
-    def ground_at(px: float, py: float) -> float:
-        return _ground_height(height_field, slopes, patches, px, py)
+    # The budgets before anything that grows with them is made. A world over them is refused
+    # anyway: its objects, tunnels and walls take the plane's height, without a search.
+    over = _budget_problems(entries, problems)
 
+    def ground_at(px: float, py: float) -> float:
+        return 0.0 if over else _ground_height(height_field, slopes, patches, px, py)
+
+    meshes: List[Tuple[str, str, str]] = []
     objects = tuple(
-        _object(name, index, v, raw, base_dir=base_dir, ground_at=ground_at, problems=problems)
+        _object(name, index, v, raw, base_dir=base_dir, ground_at=ground_at, problems=problems, meshes=meshes)
         for name, index, v, raw in entries["objects"]
     )
+    _mesh_problems(meshes, problems)
     rows = tuple(_rows(name, index, v, problems) for name, index, v, _ in entries["rows"])
     polytunnels = tuple(
         _polytunnel(name, index, v, ground_at, problems) for name, index, v, _ in entries["polytunnels"]
     )
-    walls = tuple(_wall(name, index, v, ground_at) for name, index, v, _ in entries["walls"])
+    walls = tuple(_wall(name, index, v, ground_at, sample=not over) for name, index, v, _ in entries["walls"])
 
     if problems:
         raise ConfigError(source, problems, WHAT)
@@ -1315,7 +1398,8 @@ def _file(value: str, base_dir: str, path: str, problems: List[Problem], extensi
     return full
 
 
-def _object(name, index, v, raw, *, base_dir, ground_at, problems) -> WorldObject:
+def _object(name, index, v, raw, *, base_dir, ground_at, problems, meshes) -> WorldObject:
+    """The object; a mesh's (key path, value, absolute file) goes to meshes, read by :func:`_mesh_problems`."""
     path = f"objects.{name}"
     shape = v["shape"]
     others = {k for keys in SHAPE_KEYS.values() for k in keys} - set(SHAPE_KEYS[shape])
@@ -1328,7 +1412,10 @@ def _object(name, index, v, raw, *, base_dir, ground_at, problems) -> WorldObjec
     dims = {k: v[k] or 0.0 for k in ("size_x", "size_y", "size_z", "radius", "length")}
     file = ""
     if shape == "mesh" and v["file"]:
+        found = len(problems)
         file = _file(v["file"], base_dir, f"{path}.file", problems, MESH_EXTENSIONS)
+        if len(problems) == found:
+            meshes.append((f"{path}.file", v["file"], file))
     colour = v["rgba"] or RGBA_WOOD
     thing = WorldObject(
         name, index, shape, v["x"], v["y"], 0.0, v["roll"], v["pitch"], v["yaw"], **dims, file=file,
@@ -1348,11 +1435,6 @@ def _rows(name, index, v, problems) -> Rows:
     if rows.plant == "sphere" and rows.plant_height < rows.plant_radius and not _broken(problems, path, "plant_height"):
         rule = f"must be >= plant_radius ({rows.plant_radius} m) for a sphere: its centre would be below the ground"
         problems.append(Problem(f"{path}.plant_height", rows.plant_height, rule))
-    if not _broken(problems, path, "count", "length", "plant_spacing"):
-        plants = rows.count * rows.plants_per_row
-        if plants > MAX_PLANTS:
-            rule = f"makes {plants} plants with count {rows.count} and length {rows.length} m; at most {MAX_PLANTS}"
-            problems.append(Problem(f"{path}.plant_spacing", rows.plant_spacing, rule))
     return rows
 
 
@@ -1377,7 +1459,7 @@ def _polytunnel(name, index, v, ground_at, problems) -> Polytunnel:
         rule = f"times tables ({t.tables}) must be < width ({t.width} m): an aisle between the tables"
         problems.append(Problem(f"{path}.table_width", t.table_width, rule))
         return tunnel
-    outer = max(abs(o) for o in t.table_offsets()) + t.table_width / 2
+    outer = max(abs(t.table_offset(0)), abs(t.table_offset(t.tables - 1))) + t.table_width / 2
     roof = t.roof_height(outer) - t.tube / 2
     if t.crop_top + 1.5 * t.plant_radius >= roof:
         key = "table_height" if t.crop == "table_tops" else "bed_height"
@@ -1388,10 +1470,15 @@ def _polytunnel(name, index, v, ground_at, problems) -> Polytunnel:
     return tunnel
 
 
-def _wall(name, index, v, ground_at) -> Wall:
-    # the foot follows the lowest ground along the wall's centre line (every 0.5 m)
-    n = max(1, math.ceil(v["length"] / 0.5))
-    foot = min(ground_at(*_along(v["x"], v["y"], v["yaw"], v["length"] * (k / n - 0.5), 0.0)) for k in range(n + 1))
+def _wall(name, index, v, ground_at, sample: bool = True) -> Wall:
+    # the foot follows the lowest ground along the wall's centre line (every WALL_STEP); without
+    # sample (a world over its budgets), the ground at its centre
+    if sample:
+        n = _wall_steps(v["length"])
+        along = (_along(v["x"], v["y"], v["yaw"], v["length"] * (k / n - 0.5), 0.0) for k in range(n + 1))
+        foot = min(ground_at(*point) for point in along)
+    else:
+        foot = ground_at(v["x"], v["y"])
     return Wall(
         name, index, v["x"], v["y"], foot, v["yaw"], v["length"], v["height"], v["thickness"],
         v["rgba"] or RGBA_CONCRETE, _surface(v),
@@ -1408,6 +1495,8 @@ def _height_field(raw: Any, base_dir: str, problems: List[Problem]) -> Optional[
         image = _file(v["image"], base_dir, f"{path}.image", problems)
         if os.path.isfile(image):
             try:
+                # its size from its header first: a huge image is refused before it is decoded
+                _check_image_budget(image)
                 levels = _image_levels(image)
             except ValueError as e:
                 problems.append(Problem(f"{path}.image", v["image"], str(e)))
@@ -1436,13 +1525,197 @@ def _height_field(raw: Any, base_dir: str, problems: List[Problem]) -> Optional[
         return None  # the problem is reported; there is no grid to make
     if levels is not None:
         hf.__dict__["_levels"] = levels  # the image as read to check it (the cached property's place)
-    nx, ny = hf.grid_shape()
-    if nx * ny > MAX_FIELD_POINTS:
-        rule = f"makes {nx} x {ny} grid points; at most {MAX_FIELD_POINTS}"
-        key = "image" if image else "resolution"
-        problems.append(Problem(f"{path}.{key}", raw.get(key, hf.resolution), rule))
-        return None
+    else:
+        # counted as floats: a tiny resolution makes a count beyond any budget, not an OverflowError
+        nx, ny = (max(2.0, _rounded(size / hf.resolution) + 1) for size in (hf.size_x, hf.size_y))
+        if nx * ny > MAX_FIELD_POINTS:
+            rule = f"makes {_n(nx)} x {_n(ny)} grid points; at most {MAX_FIELD_POINTS}"
+            problems.append(Problem(f"{path}.resolution", raw.get("resolution", hf.resolution), rule))
+            return None
+    if hf.amplitude > 0:
+        ni, nj = _noise_lattice(hf.size_x, hf.feature_length), _noise_lattice(hf.size_y, hf.feature_length)
+        if ni * nj > MAX_NOISE_POINTS:
+            rule = f"makes {_n(ni)} x {_n(nj)} noise lattice points (size / feature_length); at most {MAX_NOISE_POINTS}"
+            problems.append(Problem(f"{path}.feature_length", hf.feature_length, rule))
+            return None
     return hf
+
+
+def _check_image_budget(path: str) -> None:
+    """ValueError (the rule) if the image's file or its pixels (from its header) are over the budgets."""
+    size = os.path.getsize(path)
+    if size > MAX_IMAGE_BYTES:
+        raise ValueError(f"is a file of {size} bytes; at most {MAX_IMAGE_BYTES}")
+    width, height = _image_size(path)
+    if width * height > MAX_FIELD_POINTS:
+        raise ValueError(f"makes {width} x {height} grid points (its pixels); at most {MAX_FIELD_POINTS}")
+
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def _image_size(path: str) -> Tuple[int, int]:
+    """(width, height) of the image from its header, without decoding it; ValueError if it cannot be read.
+
+    A PNG's are read here (its IHDR chunk: PIL refuses a PNG of more than 179 million pixels with a
+    DecompressionBombError that hides the size); another format's through PIL, which reads only the
+    header until the image is loaded.
+    """
+    from PIL import Image, UnidentifiedImageError  # noqa: PLC0415
+
+    with open(path, "rb") as f:
+        head = f.read(24)
+    if head[:8] == PNG_SIGNATURE:
+        if len(head) < 24 or head[12:16] != b"IHDR":
+            raise ValueError("cannot read the image: a PNG file without its IHDR header")
+        return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            with Image.open(path) as image:
+                return image.size
+    except (OSError, UnidentifiedImageError, Image.DecompressionBombError) as e:
+        raise ValueError(f"cannot read the image: {e}") from None
+
+
+def _rounded(ratio: float) -> float:
+    """round(ratio), as a float; a ratio too big to be any count (inf for a tiny spacing) is itself."""
+    return float(round(ratio)) if ratio < 1e15 else ratio
+
+
+def _floored(ratio: float) -> float:
+    """math.floor(ratio + 1e-9) (a whole number of spacings, though floating point makes it 2.9999...)
+    as a float; a ratio too big to be any count is itself."""
+    return float(math.floor(ratio + 1e-9)) if ratio < 1e15 else ratio
+
+
+def _n(count: float) -> str:
+    """A count (a float from :func:`_rounded`) as the message says it."""
+    if count < 1e15:
+        return str(int(count))
+    return f"{count:.3g}" if math.isfinite(count) else "more than 1e308"
+
+
+def _noise_lattice(size: float, feature_length: float) -> float:
+    """Lattice points along one side of a field's noise (as :func:`_value_noise` makes them)."""
+    half = size / 2 / feature_length
+    return half * 2 + 3 if half >= 1e15 else float(math.floor(half) - math.floor(-half) + 2)
+
+
+def _wall_steps(length: float) -> int:
+    """Steps of WALL_STEP (at most) along a wall: its points are one more."""
+    return max(1, math.ceil(length / WALL_STEP))
+
+
+# ---------------------------------------------------------------------------------------------
+# Budgets of the whole world (the module's "Limits"), counted from the parsed numbers before
+# anything is made
+# ---------------------------------------------------------------------------------------------
+Share = Tuple[str, Any, float]  # (key path, its value, how much of a budget its entry takes)
+Entries = Mapping[str, Sequence[Tuple[str, int, dict, Mapping]]]
+
+
+def _row_plants(v: Mapping) -> float:
+    """Places for plants (gaps included: each draws its random numbers) of a rows entry's values."""
+    return v["count"] * (_floored(v["length"] / v["plant_spacing"]) + 1)
+
+
+def _tunnel_counts(v: Mapping) -> Tuple[float, float, float, float]:
+    """(hoops, pairs of table legs, plants, bodies) of a polytunnels entry's values, as
+    :class:`Polytunnel` and the scene make them."""
+    hoops = max(1.0, _rounded(v["length"] / v["hoop_spacing"])) + 1
+    if v["crop"] == "none":
+        return hoops, 0.0, 0.0, 3.0
+    span = v["length"] - 2 * v["end_gap"]
+    tables = v["tables"]
+    legs = tables * (max(1.0, _rounded(span / v["leg_spacing"])) + 1) if v["crop"] == "table_tops" else 0.0
+    plants = tables * max(0.0, _floored(span / v["plant_spacing"]))
+    # the legs of each side and the roof; each table's table, plants and berries
+    return hoops, legs, plants, 3.0 + 3.0 * tables
+
+
+def _budget_problems(entries: Entries, problems: List[Problem]) -> bool:
+    """Adds a problem for each budget the world's entries break; whether any is broken."""
+    found: List[Problem] = []
+
+    def at(section: str, key: str) -> List[Tuple[str, Any, dict]]:
+        """(key path, the file's value or else the default, values) of the key of each entry."""
+        return [(f"{section}.{name}.{key}", raw.get(key, v[key]), v) for name, _, v, raw in entries[section]]
+
+    row_plants = [(path, value, _row_plants(v)) for path, value, v in at("rows", "plant_spacing")]
+    plants = row_plants + [(path, value, _tunnel_counts(v)[2]) for path, value, v in at("polytunnels", "plant_spacing")]
+    found.append(_over(plants, MAX_PLANTS, "plants over the world's rows and polytunnels"))
+    hoops = [(path, value, _tunnel_counts(v)[0]) for path, value, v in at("polytunnels", "hoop_spacing")]
+    found.append(_over(hoops, MAX_HOOPS, "hoops over the world's polytunnels"))
+    legs = [(path, value, _tunnel_counts(v)[1]) for path, value, v in at("polytunnels", "leg_spacing")]
+    found.append(_over(legs, MAX_TABLE_LEGS, "pairs of table legs over the world's polytunnels"))
+
+    # one body an entry, two a rail (its pipes), one a row, three a tunnel and three each of its
+    # tables; and the ground
+    bodies = [(key, len(entries[key]), (2.0 if key == "rails" else 1.0) * len(entries[key])) for key in SINGLES]
+    bodies += [(path, value, float(v["count"])) for path, value, v in at("rows", "count")]
+    bodies += [(path, value, _tunnel_counts(v)[3]) for path, value, v in at("polytunnels", "tables")]
+    found.append(_over(bodies, MAX_BODIES, "pybullet bodies over the world's entries and the ground", extra=1))
+
+    patches = [v for _, _, v, _ in entries["patches"]]
+    soft = any(_surface_of(v, SURFACE_DEFAULTS).soft for v in patches)
+    if soft and len(patches) > MAX_HOLES:
+        rule = f"makes {len(patches)} holes in the ground (one under every patch, as one is soft); at most {MAX_HOLES}"
+        found.append(Problem("patches", len(patches), rule))
+
+    # Each plant, point along a wall, object and tunnel looks for the ground under it: the height
+    # field (or the plane), every hill and every patch.
+    searched = 1 + len(entries["slopes"]) + len(entries["patches"])
+    points = [(path, value, n * searched) for path, value, n in row_plants]
+    points += [(path, value, (_wall_steps(v["length"]) + 1.0) * searched) for path, value, v in at("walls", "length")]
+    points += [(key, len(entries[key]), len(entries[key]) * searched) for key in ("objects", "polytunnels")]
+    what = f"ground look-ups (plants, points every {WALL_STEP:g} m along walls, objects and tunnels, each over"
+    what += f" the ground, {searched - 1} hills and patches)"
+    lookups = _over(points, MAX_GROUND_LOOKUPS, what)
+    # said once a key: too many plants (the first budget) are too many look-ups too
+    if lookups is not None and all(pr is None or pr.path != lookups.path for pr in found):
+        found.append(lookups)
+
+    found = [pr for pr in found if pr is not None]
+    problems.extend(found)
+    return bool(found)
+
+
+# the sections whose entries are one pybullet body each (a rail two)
+SINGLES = ("patches", "slopes", "rails", "objects", "walls")
+
+
+def _over(shares: Sequence[Share], limit: int, what: str, extra: float = 0.0) -> Optional[Problem]:
+    """The problem of a budget the shares (and extra, at no key) break, at the largest share's key; None within it."""
+    total = sum(amount for _, _, amount in shares) + extra
+    if total <= limit:
+        return None
+    path, value, amount = max(shares, key=lambda share: share[2])
+    here = f", {_n(amount)} of them here" if amount < total else ""
+    return Problem(path, value, f"makes {_n(total)} {what}{here}; at most {limit}")
+
+
+def _mesh_problems(meshes: Sequence[Tuple[str, str, str]], problems: List[Problem]) -> None:
+    """Problems of the mesh files (key path, value, absolute file) the objects name: their sizes over
+    the budget first (nothing is read then), else each file that is not a mesh pybullet can load."""
+    sized = []
+    for path, value, file in meshes:
+        try:
+            sized.append((path, value, file, float(os.path.getsize(file))))
+        except OSError as e:
+            problems.append(Problem(path, value, f"cannot be read ({file}): {e.strerror}"))
+    shares = [(path, value, size) for path, value, _, size in sized]
+    # each object loads its file: pybullet makes a collision shape and a visual shape of each
+    over = _over(shares, MAX_MESH_BYTES, "bytes of mesh files over the world's objects (each object's counted)")
+    if over is not None:
+        problems.append(over)
+        return
+    reasons: Dict[str, Optional[str]] = {}
+    for path, value, file, _ in sized:
+        if file not in reasons:
+            reasons[file] = mesh_problem(file)
+        if reasons[file]:
+            problems.append(Problem(path, value, f"is not a mesh pybullet can load ({file}): {reasons[file]}"))
 
 
 # ---------------------------------------------------------------------------------------------

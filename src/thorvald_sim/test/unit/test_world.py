@@ -240,7 +240,7 @@ rails:
     assert err.source == path and err.what == "world"
     lines = str(err).splitlines()
     assert lines[0] == f"{path}: invalid world (5 problems):"
-    assert f"  {path}: patches.patch0.size_x: -1.5: must be > 0" in lines
+    assert f"  {path}: patches.patch0.size_x: -1.5: must be in (0, 10000] [m]" in lines
     assert f"  {path}: gravity: 0: must be > 0" in lines
     assert f"  {path}: ground.restitution: 1.5: must be in [0, 1]" in lines
     assert f"  {path}: slopes.slope0.angle: 1.3: must be in (0, 1.2] [rad]" in lines
@@ -288,7 +288,7 @@ def test_an_invalid_radius_is_reported_once_not_compared_as_its_default():
     # the default radius (0.0255) is above this height, but the file holds no such radius
     found, _ = problems_of({"rails": {"rail0": {"x": 0, "y": 0, "length": 5, "height": 0.02, "radius": -1}}})
     assert list(found) == ["rails.rail0.radius"]
-    assert found["rails.rail0.radius"].rule == "must be > 0"
+    assert found["rails.rail0.radius"].rule == "must be in (0, 10000] [m]"
 
 
 def test_pipes_cannot_overlap():

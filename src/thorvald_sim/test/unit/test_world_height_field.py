@@ -69,15 +69,15 @@ def test_each_rule():
         }
     )
     assert {k: pr.rule for k, pr in found.items()} == {
-        "height_field.amplitude": "must be >= 0",
-        "height_field.flat_radius": "must be >= 0",
+        "height_field.amplitude": "must be in [0, 10000] [m]",
+        "height_field.flat_radius": "must be in [0, 10000] [m]",
         "height_field.seed": "must be an integer",
         "height_field.min_height": "is used with an image only",
         "height_field.max_height": "must be > min_height (1.0 m)",
         "height_field.rut_width": "must be <= rut_spacing (1.5 m)",
     }
     found = problems_of({"height_field": {"size_x": -1, "size_y": 6}})
-    assert {k: pr.rule for k, pr in found.items()} == {"height_field.size_x": "must be > 0"}
+    assert {k: pr.rule for k, pr in found.items()} == {"height_field.size_x": "must be in (0, 10000] [m]"}
     found = problems_of({"height_field": {"size_x": 1000, "size_y": 1000, "resolution": 0.5}})
     assert found["height_field.resolution"].rule == "makes 2001 x 2001 grid points; at most 1000000"
     found = problems_of({"height_field": {"size_x": 10}, "heightfield": {}})

@@ -119,7 +119,7 @@ def test_each_shape_requires_its_dimensions_and_refuses_the_others():
         "objects.object0.radius": "is not a key of a box (it takes size_x, size_y, size_z)",
         "objects.object0.size_z": "is required for a box",
         "objects.object1.length": "is required for a cylinder",
-        "objects.object2.radius": "must be > 0",  # reported once: not "is required" as well
+        "objects.object2.radius": "must be in (0, 10000] [m]",  # reported once: not "is required" as well
         "objects.object2.scale": "is not a key of a sphere (it takes radius)",
         "objects.object3.length": "is not a key of a mesh (it takes file, scale)",
         "objects.object3.file": "is required for a mesh",
@@ -149,8 +149,8 @@ def test_walls_defaults_rules_and_their_foot_on_a_slope():
     assert (wall.rgba, wall.surface) == ((0.75, 0.74, 0.7, 1.0), Surface(0.8, 0.0, 0.0))
     found = problems_of({"walls": {"wall0": {"x": 0, "y": 0, "length": 0, "thickness": -1, "rgba": [2, 0, 0]}}})
     assert {path: pr.rule for path, pr in found.items()} == {
-        "walls.wall0.length": "must be > 0",
-        "walls.wall0.thickness": "must be > 0",
+        "walls.wall0.length": "must be in (0, 10000] [m]",
+        "walls.wall0.thickness": "must be in (0, 10000] [m]",
         "walls.wall0.rgba": "must be a list of 3 or 4 numbers in [0, 1] (red, green, blue, alpha)",
     }
     # a wall across a hill's foot: its foot at the lowest ground along it, the plane's 0

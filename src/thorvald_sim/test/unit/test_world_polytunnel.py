@@ -86,9 +86,9 @@ def test_the_tunnel_frame_turns_with_yaw():
         ({"table_width": 2.0}, "table_width", "times tables (4) must be < width (8.0 m): an aisle between the tables"),
         ({"crop": "hydroponics"}, "crop", "must be one of table_tops, ground_beds, none"),
         ({"tables": 0}, "tables", "must be > 0"),
-        ({"table_height": 0.1}, "table_height", f"must be > {TABLE_DEPTH} (the trough)"),
-        ({"leg_height": -1}, "leg_height", "must be >= 0"),
-        ({"hoop_spacing": 0}, "hoop_spacing", "must be > 0"),
+        ({"table_height": 0.1}, "table_height", f"must be in ({TABLE_DEPTH}, 10000] [m] (above the trough's depth)"),
+        ({"leg_height": -1}, "leg_height", "must be in [0, 10000] [m]"),
+        ({"hoop_spacing": 0}, "hoop_spacing", "must be in (0, 10000] [m]"),
     ],
 )
 def test_each_rule(keys, path, rule):
