@@ -28,19 +28,27 @@ Pure: no pybullet, no rospy, no messages.
 import dataclasses
 import json
 import math
+import os
 import random
+import re
 from dataclasses import dataclass
 from typing import Any, Dict, List, Mapping, Optional, Tuple
 
 from thorvald_base.can.protocol import DriveScaling
 from thorvald_model.errors import MISSING, ConfigError, Problem
 from thorvald_model.schema import Key, check_top_level, non_negative, parse_entry, parse_scalar, read_yaml_file
+from thorvald_model.value_text import value_text
 from thorvald_model.values import RobotConfig
 
 WHAT = "as-built file"
 MAX_RADIUS_CHANGE = 0.2  # of the configured r_wheel: beyond it the file describes another wheel
 MAX_STEERING_OFFSET = 0.2  # [rad], about 11 degrees: beyond it the module is broken, not mis-homed
 MAX_DELAY = 1.0  # [s]
+# A profile's seed: at most what 64 bits hold (random.Random takes any integer, but reading one of a
+# million digits takes seconds, and Python 3.11 refuses past 4300)
+MAX_SEED = 2**64 - 1
+SEED_TEXT = re.compile(r"[0-9]+")
+PROFILE_SPEC = re.compile(r"[A-Za-z_][\w-]*:[^/]*")  # NAME:... without a slash: a profile, unless such a file exists
 
 DRIVE_KEYS = (
     Key("r_wheel", float, None, check=lambda v: v > 0, rule="must be > 0"),
@@ -164,18 +172,33 @@ def load_as_built(path: str, config: RobotConfig) -> AsBuilt:
     return parse_as_built(read_yaml_file(path, WHAT), config, path)
 
 
-def draw_as_built(profile_and_seed: str, config: RobotConfig) -> AsBuilt:
-    """A robot drawn from a profile's tolerances with a seed: ``field:7``."""
-    name, _, seed_text = profile_and_seed.partition(":")
-    problem = None
+def profile_and_seed(spec: str) -> Tuple[Profile, int]:
+    """The profile and the seed a ``PROFILE:SEED`` spec names; ConfigError (the spec, the rule)."""
+    name, _, seed_text = spec.partition(":")
+    seed_text = seed_text.strip()
     if name not in PROFILES:
-        problem = Problem("", profile_and_seed, "the profile must be one of " + ", ".join(sorted(PROFILES)))
-    elif not seed_text.strip().lstrip("-").isdigit():
-        problem = Problem("", profile_and_seed, f"must be PROFILE:SEED with an integer seed, e.g. {name}:1")
-    if problem is not None:
-        raise ConfigError("<as-built profile>", [problem], WHAT)
-    profile = PROFILES[name]
-    rng = random.Random(int(seed_text))
+        known = ", ".join(sorted(PROFILES))
+        rule = f"no as-built profile {value_text(name, 40)} (the profiles: {known}) and no file of that name"
+    # ASCII digits only ("²" is a digit to str.isdigit, not to int), no sign, and the length first:
+    # a seed of a million digits is refused before it is converted
+    elif not SEED_TEXT.fullmatch(seed_text) or len(seed_text) > len(str(MAX_SEED)) or int(seed_text) > MAX_SEED:
+        rule = f"{name}:SEED: SEED must be a whole number from 0 to {MAX_SEED} (an integer seed), e.g. {name}:7"
+    else:
+        return PROFILES[name], int(seed_text)
+    raise ConfigError(_shown(spec), [Problem("", MISSING, rule)], "as-built profile")
+
+
+def is_profile_spec(spec: str) -> bool:
+    """Whether ``-as_built`` / ``as_built:=`` names a profile and seed rather than a file: a known
+    profile's name before a colon, or any NAME:... without a slash where no such file exists (a
+    misspelt profile, said so, rather than a missing file)."""
+    return spec.partition(":")[0] in PROFILES or (PROFILE_SPEC.fullmatch(spec) is not None and not os.path.exists(spec))
+
+
+def draw_as_built(spec: str, config: RobotConfig) -> AsBuilt:
+    """A robot drawn from a profile's tolerances with a seed: ``field:7``."""
+    profile, seed = profile_and_seed(spec)
+    rng = random.Random(seed)
     draws = []
     for d in config.drives:
         # two draws a drive, steered or not, so one drive's type does not move the others' draws
@@ -187,15 +210,15 @@ def draw_as_built(profile_and_seed: str, config: RobotConfig) -> AsBuilt:
         DriveAsBuilt(_name(i), d.r_wheel * scale * (1.0 - loaded), offset)
         for i, (d, (scale, offset)) in enumerate(zip(config.drives, draws))
     )
-    return AsBuilt(profile_and_seed, drives, profile.encoders, 0.0, 0.0, _radii(config), loaded)
+    return AsBuilt(spec, drives, profile.encoders, 0.0, 0.0, _radii(config), loaded)
 
 
 def as_built_for(spec: str, config: RobotConfig) -> AsBuilt:
     """What ``-as_built`` / ``as_built:=`` names: "" (as configured), a profile and seed
-    (``field:7``) or a file."""
+    (``field:7``) or a file; ConfigError naming the spec or the file and the rule."""
     if not spec:
         return as_configured(config)
-    if spec.partition(":")[0] in PROFILES:
+    if is_profile_spec(spec):
         return draw_as_built(spec, config)
     return load_as_built(spec, config)
 
@@ -314,6 +337,11 @@ def describe_as_built(built: AsBuilt) -> str:
     return ", ".join(drives + extras)
 
 
+def _shown(spec: str) -> str:
+    """A spec as a message's source: itself, or its repr cut, when it is long or not printable."""
+    return spec if len(spec) <= 60 and spec.isprintable() else value_text(spec, 60)
+
+
 def _name(index: int) -> str:
     return f"drive{index}"
 
@@ -356,7 +384,9 @@ __all__ = [
     "describe_as_built",
     "draw_as_built",
     "for_simulator",
+    "is_profile_spec",
     "load_as_built",
     "parse_as_built",
+    "profile_and_seed",
     "quantise",
 ]

@@ -328,6 +328,13 @@ class SimulatorNode:
         return EmptyResponse()
 
     def srv_spawn(self, req):
+        from .spawn_names import model_name_problem, namespace_problem  # noqa: PLC0415 (the spawn's own rules)
+
+        # any client may call: the names are checked before either appears in a line or a topic
+        problem = model_name_problem(req.model_name) or namespace_problem(req.robot_namespace)
+        if problem:
+            rospy.logerr("simulator: refused to spawn: %s", problem)
+            return SpawnRobotResponse(False, problem)
         pose = Pose2D(req.x, req.y, req.z, req.yaw)
         if not all(math.isfinite(v) for v in (req.x, req.y, req.z, req.yaw)):
             return SpawnRobotResponse(False, f"{req.model_name}: the spawn pose must be finite")

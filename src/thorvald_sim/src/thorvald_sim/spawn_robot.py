@@ -6,9 +6,11 @@ is that namespace's parameter, and the robot's topics live there.
 
   -param P | -file F     the URDF: a parameter (relative to the namespace) or a file
   -urdf                  accepted (the description is always URDF)
-  -model NAME            the robot's name in the world
+  -model NAME            the robot's name in the world: a ROS base name (a letter, then letters,
+                         digits and underscores)
   -x X -y Y -z Z -Y YAW  base_link's spawn pose [m, rad]; -R and -P (roll, pitch) must be 0
-  -robot_namespace NS    where its topics live (default: this node's namespace)
+  -robot_namespace NS    where its topics live (default: this node's namespace): a legal ROS name,
+                         not private (~)
   -gazebo_namespace S    the simulator node (default /simulator); -simulator S is the same
   -command_topic T       follow T instead of the description's (base_state)
   -publish_tf / -no_publish_tf   odom -> base_link from ground truth (default: the simulator's ~publish_tf)
@@ -18,7 +20,8 @@ is that namespace's parameter, and the robot's topics live there.
   -unpause               unpause the simulation after spawning
   -timeout T             seconds to wait for the simulator (default 60)
 
-Exit status 0 when the robot is in the world, 1 with the reason when not.
+Exit status 0 when the robot is in the world, 1 with the reason when not, 2 for a wrong argument
+(argparse's message: the argument, the value and the rule).
 """
 
 import argparse
@@ -32,6 +35,19 @@ from thorvald_model import ConfigError, load_robot_config
 from thorvald_msgs.srv import SpawnRobot
 
 from .as_built import as_built_for, for_simulator
+from .spawn_names import model_name_problem, namespace_problem
+
+
+def _checked(problem_of):
+    """An argparse type that refuses a value problem_of finds a problem with, saying it."""
+
+    def check(value: str) -> str:
+        problem = problem_of(value)
+        if problem:
+            raise argparse.ArgumentTypeError(problem)
+        return value
+
+    return check
 
 
 def parse_args(argv: List[str]) -> argparse.Namespace:
@@ -40,10 +56,15 @@ def parse_args(argv: List[str]) -> argparse.Namespace:
     source.add_argument("-param", help="parameter holding the URDF, e.g. robot_description")
     source.add_argument("-file", help="URDF file")
     parser.add_argument("-urdf", action="store_true", help="accepted: the description is URDF")
-    parser.add_argument("-model", required=True, help="the robot's name in the world")
+    parser.add_argument(
+        "-model",
+        required=True,
+        type=_checked(model_name_problem),
+        help="the robot's name in the world (a ROS base name)",
+    )
     for axis in ("x", "y", "z", "R", "P", "Y"):
         parser.add_argument("-" + axis, type=float, default=0.0)
-    parser.add_argument("-robot_namespace", default=None)
+    parser.add_argument("-robot_namespace", type=_checked(namespace_problem), default=None)
     parser.add_argument("-gazebo_namespace", "-simulator", dest="simulator", default="/simulator")
     parser.add_argument("-command_topic", default="")
     tf = parser.add_mutually_exclusive_group()
@@ -86,8 +107,9 @@ def read_as_built(args) -> str:
 
 
 def main(argv: Optional[List[str]] = None) -> int:
-    rospy.init_node("spawn_robot", anonymous=True)
+    # the arguments first: a wrong one is refused (exit status 2) without a master
     args = parse_args(rospy.myargv(argv if argv is not None else sys.argv)[1:])
+    rospy.init_node("spawn_robot", anonymous=True)
     if args.R or args.P:
         print("spawn_robot: -R and -P must be 0: robots are spawned upright on the ground", file=sys.stderr)
         return 1
