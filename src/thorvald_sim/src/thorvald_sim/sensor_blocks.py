@@ -27,6 +27,32 @@ to log once); a block that breaks a rule (a missing ``<samples>``, a negative ra
 without an image size) is listed in :attr:`SensorBlocks.refused` with the link, the element path
 and the rule, and the other sensors are kept.
 
+What one reading may cost is bounded here, before anything is allocated, so that no block can
+take the simulator down (a reading runs in the simulation's loop: while it lasts, the clock and
+every robot wait, and a failed allocation inside pybullet aborts the process):
+
+==========================  ==========  ===================================================================
+bound                       limit       why
+==========================  ==========  ===================================================================
+camera width, height [px]   8192        wider than any camera a robot carries (8K UHD is 7680 wide)
+camera pixels (w x h)       2^24        a 4096 x 4096 frame; 4K (3840 x 2160, 4096 x 2160) and a Kinect v2
+                                        (1920 x 1080) pass. A reading costs about 40 bytes a pixel (110
+                                        with depth and point cloud) and 0.25-0.5 us of rendering a pixel:
+                                        at the limit about 1.8 GB and 8 s a depth frame
+lidar rays (samples x       2^19        4096 x 128: the densest mode of a 128-channel lidar (4096 columns);
+vertical samples)                       a reading costs about 1-2 us and 170 bytes a ray: at the limit
+                                        about 1.1 s and 90 MB
+==========================  ==========  ===================================================================
+
+pybullet's TinyRenderer keeps an RGB, a depth, a shadow and a segmentation buffer per pixel (15
+bytes), its client copies RGBA, depth and segmentation (12 bytes) and pybullet hands them over as
+numpy arrays (12 bytes more); it counts those bytes in C ``int``, which overflows past 2^29 pixels
+(a 100000 x 100000 camera is 10^10). A lidar's rays go to pybullet 16383 at a time, so a reading's
+time grows with its rays alone. Nothing else a block sets scales a reading's cost: a rate above the
+physics rate is read once a step (:class:`thorvald_sim.sensors.Schedule`; the simulator's
+/diagnostics warns of it), and a ray's length costs nothing more (2000 rays over a height field
+cost the same from 30 m to 10^9 m).
+
 Topic and frame names stay as the block writes them; :func:`resolve_topic` and
 :func:`resolve_frame` apply the robot's namespace and tf_prefix as the plugins do (each sensor's
 ``frame_rule`` says which way).
@@ -69,6 +95,11 @@ HECTOR_DRIFT_FREQUENCY = 1.0 / 3600.0  # [1/s]: SensorModel's default time const
 
 # Image formats of Gazebo's <image><format> and the sensor_msgs encodings they are published in
 IMAGE_FORMATS = {"R8G8B8": ("rgb8", 3), "B8G8R8": ("bgr8", 3), "L8": ("mono8", 1), "RGB_INT8": ("rgb8", 3)}
+
+# What one reading may cost (the module's docstring says why these figures)
+MAX_IMAGE_SIDE = 8192  # [px] a camera's width or height
+MAX_IMAGE_PIXELS = 2**24  # [px] width x height: 4096 x 4096
+MAX_RAYS = 2**19  # a lidar's samples x vertical samples: 4096 x 128
 
 
 @dataclass(frozen=True)
@@ -303,6 +334,17 @@ def _namespace(plugin: _Element) -> Optional[str]:
 # ---------------------------------------------------------------------------------------------
 # Sensors (<gazebo reference="LINK"><sensor>)
 # ---------------------------------------------------------------------------------------------
+def _check_rays(scan: _Element, samples: int, vertical: int) -> None:
+    """BlockError unless a reading's rays (samples x vertical samples) are within MAX_RAYS."""
+    why = f"<= {MAX_RAYS} rays a reading (4096 columns x 128 channels; a ray costs about 1-2 us)"
+    for tag, n in (("horizontal/samples", samples), ("vertical/samples", vertical)):
+        if n > MAX_RAYS:
+            raise BlockError(f"{scan.path}/{tag}", f"{n} must be {why}")
+    if samples * vertical > MAX_RAYS:
+        rays = f"{samples} x {vertical} = {samples * vertical}"
+        raise BlockError(scan.path, f"samples x vertical samples = {rays} must be {why}")
+
+
 def _ray(sensor: _Element) -> RayConfig:
     ray = sensor.required("ray", "a ray sensor needs <ray>")
     scan = ray.required("scan", "a ray sensor needs <scan>")
@@ -320,6 +362,7 @@ def _ray(sensor: _Element) -> RayConfig:
             raise BlockError(f"{vertical.path}/max_angle", f"{v_max!r} must be >= min_angle ({v_min!r})")
     else:
         v_samples, v_min, v_max = 1, 0.0, 0.0
+    _check_rays(scan, samples, v_samples)
     rng = ray.required("range", "a ray sensor needs <range> (min, max)")
     range_min = rng.number("min", rule=NON_NEGATIVE[0], check=NON_NEGATIVE[1])
     range_max = rng.number("max", rule=f"must be > min ({range_min!r})", check=lambda v: v > range_min)
@@ -432,6 +475,19 @@ def _gps_sensor(found: _Found) -> SensorSpec:
     )  # fmt: skip
 
 
+def _check_pixels(image: _Element, width: int, height: int) -> None:
+    """BlockError unless a frame's sides and pixels are within MAX_IMAGE_SIDE and MAX_IMAGE_PIXELS."""
+    for tag, n in (("width", width), ("height", height)):
+        if n > MAX_IMAGE_SIDE:
+            raise BlockError(f"{image.path}/{tag}", f"{n} must be <= {MAX_IMAGE_SIDE} pixels (no camera is wider)")
+    if width * height > MAX_IMAGE_PIXELS:
+        raise BlockError(
+            image.path,
+            f"width x height = {width} x {height} = {width * height} pixels must be <= {MAX_IMAGE_PIXELS} (4096 x 4096:"
+            " a frame costs about 110 bytes and 0.5 us of rendering a pixel)",
+        )
+
+
 def _camera(found: _Found, depth: bool) -> SensorSpec:
     sensor, plugin, link, name, filename, rate = _unpack(found)
     camera = sensor.required("camera", "a camera sensor needs <camera>")
@@ -444,8 +500,10 @@ def _camera(found: _Found, depth: bool) -> SensorSpec:
     clip = camera.child("clip")
     near = clip.number("near", 0.1, rule=POSITIVE[0], check=POSITIVE[1]) if clip else 0.1
     far = clip.number("far", 100.0, rule=f"must be > near ({near!r})", check=lambda v: v > near) if clip else 100.0
+    width, height = image.count("width", 320), image.count("height", 240)
+    _check_pixels(image, width, height)
     config = CameraConfig(
-        image.count("width", 320), image.count("height", 240), encoding, channels, hfov, near, far, depth,
+        width, height, encoding, channels, hfov, near, far, depth,
         plugin.number("pointCloudCutoff", 0.4, rule=NON_NEGATIVE[0], check=NON_NEGATIVE[1]),
         plugin.number("pointCloudCutoffMax", 5.0, rule=POSITIVE[0], check=POSITIVE[1]),
     )  # fmt: skip

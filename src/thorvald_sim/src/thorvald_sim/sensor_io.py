@@ -5,13 +5,20 @@ As gazebo_ros's plugins, a sensor is measured only while one of its topics has a
 messages are stamped with the simulated instant of the measurement. Topic and frame names are
 resolved as the plugins resolve them (:func:`thorvald_sim.sensor_blocks.resolve_topic`,
 :func:`~thorvald_sim.sensor_blocks.resolve_frame`).
+
+A sensor whose reading fails (pybullet raises, memory runs out, numpy refuses, its message cannot be
+made: whatever its reading or its messages raise) is disabled, alone: the error is logged once with
+the robot, the sensor and its topics, and it stays on /diagnostics as an error from then on
+(:attr:`SensorIO.failure`, :meth:`RobotSensors.disabled`); the simulation, its clock and every
+other sensor and robot go on. Its topics stay advertised, silent, until the robot is deleted.
 """
 
 import math
 import struct
 import time
+import traceback
 from io import BytesIO
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 import rospy
@@ -22,7 +29,7 @@ from sensor_msgs.msg import CameraInfo, Image, Imu, LaserScan, NavSatFix, NavSat
 from thorvald_base.publishing import NonBlockingPublisher
 
 from .sensor_blocks import resolve_frame, resolve_topic
-from .sensors import Sensor, SensorUse, depth_to_points
+from .sensors import DisabledSensor, Sensor, SensorUse, depth_to_points
 
 MESSAGE_TYPES = {
     "scan": LaserScan,
@@ -150,17 +157,19 @@ def search_tf_prefix(namespace: str) -> str:
 
 
 class SensorIO:
-    """One sensor's publishers, and its readings turned into messages."""
+    """One sensor's publishers, and its readings turned into messages. publisher: the publisher class,
+    called as ``publisher(topic, message type)`` (a test's may record what is published)."""
 
-    def __init__(self, sensor: Sensor, namespace: str, tf_prefix: str):
+    def __init__(self, sensor: Sensor, namespace: str, tf_prefix: str, publisher=NonBlockingPublisher):
         self.sensor = sensor
         spec = sensor.spec
         self.frame = resolve_frame(spec, tf_prefix, namespace)
         self.topics = {role: resolve_topic(spec, role, namespace) for role in spec.topics}
-        self.pubs = {role: NonBlockingPublisher(topic, MESSAGE_TYPES[role]) for role, topic in self.topics.items()}
+        self.pubs = {role: publisher(topic, MESSAGE_TYPES[role]) for role, topic in self.topics.items()}
         self.cpu = 0.0  # [s] spent measuring and publishing since the last report
         self.readings = 0
         self.active = False
+        self.failure: Optional[DisabledSensor] = None  # set when a reading failed: never read again
         self._scan_msg = None  # a planar lidar's LaserScan, reused
         self._points = None  # a depth camera's cloud, reused
 
@@ -168,7 +177,31 @@ class SensorIO:
         return {role: pub.get_num_connections() > 0 for role, pub in self.pubs.items()}
 
     def step(self, now: float, wanted: Dict[str, bool]) -> None:
-        """After a physics step at simulated time now: measure and publish if it is due and read."""
+        """After a physics step at simulated time now: measure and publish if it is due and read. A
+        reading that fails disables this sensor (see the module's docstring); nothing is raised."""
+        if self.failure is not None:
+            return
+        try:
+            self._step(now, wanted)
+        except Exception as e:  # whatever one sensor raises must not stop the simulation
+            self.disable(now, e)
+
+    def disable(self, now: float, error: BaseException) -> None:
+        """This sensor is not read again: the error logged once, kept for /diagnostics."""
+        spec = self.sensor.spec
+        what = f"{spec.describe()}: its reading failed: {type(error).__name__}: {error}"
+        self.failure = DisabledSensor(spec.name, what, tuple(self.topics.values()), now)
+        self.active = False
+        self._scan_msg = self._points = None  # a large frame's buffers go with it
+        robot = self.sensor.robot.name
+        rospy.logerr(
+            "simulator: %s: sensor %s (%s) disabled at %.3f s, the simulation goes on without it: %s",
+            robot, spec.name, ", ".join(self.topics.values()), now, what,
+        )  # fmt: skip
+        trace = "".join(traceback.format_exception(type(error), error, error.__traceback__))
+        rospy.logdebug("simulator: %s: sensor %s: %s", robot, spec.name, trace)
+
+    def _step(self, now: float, wanted: Dict[str, bool]) -> None:
         if not any(wanted.values()):
             if self.active:
                 self.sensor.schedule.pause()
@@ -336,9 +369,16 @@ class RobotSensors:
 
     CHECK_PERIOD = 0.1  # [s] simulated
 
-    def __init__(self, sensors: List[Sensor], namespace: str):
+    def __init__(
+        self,
+        sensors: List[Sensor],
+        namespace: str,
+        refused: Sequence[DisabledSensor] = (),
+        publisher=NonBlockingPublisher,
+    ):
         tf_prefix = search_tf_prefix(namespace)
-        self.ios = [SensorIO(s, namespace, tf_prefix) for s in sensors]
+        self.ios = [SensorIO(s, namespace, tf_prefix, publisher) for s in sensors]
+        self.refused = tuple(refused)  # the sensors the robot spawned without
         self._wanted: List[Dict[str, bool]] = [{} for _ in self.ios]
         self._checked = -math.inf
 
@@ -357,11 +397,15 @@ class RobotSensors:
         for io in self.ios:
             cpu, readings = io.cpu, io.readings
             io.cpu, io.readings = 0.0, 0
-            if readings or io.active:
+            if (readings or io.active) and io.failure is None:
                 spec = io.sensor.spec
                 topic = next(iter(io.topics.values()), "")
                 out.append(SensorUse(f"{spec.kind} {spec.name} ({topic})", spec.rate, cpu, readings))
         return out
+
+    def disabled(self) -> List[DisabledSensor]:
+        """The robot's sensors refused at spawn and those disabled since (for /diagnostics)."""
+        return [*self.refused, *(io.failure for io in self.ios if io.failure is not None)]
 
     def close(self) -> None:
         for io in self.ios:

@@ -26,6 +26,11 @@ the sensor has subscribers) and starts again from the instant it is read again.
   frame's +x with +z up, as Gazebo's; depth cameras also give metric depth.
 * p3d reports a link's pose and twist in the world (or in another link), with its offsets.
 
+A sensor the robot goes without is a :class:`DisabledSensor`: refused at spawn (its block breaks
+a rule, :mod:`thorvald_sim.sensor_blocks`, or its link cannot be mounted) or disabled when a
+reading of it failed (``thorvald_sim.sensor_io``); the simulator reports each on /diagnostics
+(:func:`disabled_report`) from then on.
+
 Every sensor's noise comes from its own generator, seeded from the simulation's seed, the
 robot's and sensor's names and the instant of the reading; readings fall on the multiples of the
 sensor's period. A run therefore repeats whenever its subscribers came (see InstantNoise).
@@ -33,6 +38,7 @@ sensor's period. A run therefore repeats whenever its subscribers came (see Inst
 
 import math
 import operator
+import re
 import zlib
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Tuple
@@ -50,6 +56,7 @@ from .sensor_blocks import (
     ImuConfig,
     P3dConfig,
     RayConfig,
+    SensorBlocks,
     SensorSpec,
     gps_reference,
 )
@@ -65,7 +72,9 @@ except ImportError:  # pragma: no cover - a build without Python's headers
     _scan = None
 
 _FRACTION = operator.itemgetter(2)  # of a rayTestBatch result: (object, link, fraction, ...)
-RAY_BATCH = 16384  # pybullet's largest rayTestBatch (MAX_RAY_INTERSECTION_BATCH_SIZE)
+# pybullet's largest rayTestBatch: it refuses more than MAX_RAY_INTERSECTION_BATCH_SIZE_STREAMING (16384) rays,
+# and for exactly that many it returns no results at all without an error (pybullet 3.2.7, checked)
+RAY_BATCH = 16383
 
 
 def beams(pose: Transform, directions: np.ndarray, limits: Tuple[float, float], out, *, compiled: bool = True) -> None:
@@ -305,7 +314,10 @@ class Lidar(Sensor):
         # every beam's noise drawn (inf stays inf): the same draws whatever the beams hit
         z = self.noise.normals(self.reading, len(ranges)) if c.noise_stddev > 0 else None
         for k in range(0, len(starts), RAY_BATCH):
-            hits = p.rayTestBatch(starts[k : k + RAY_BATCH], ends[k : k + RAY_BATCH], physicsClientId=self.client)
+            n = min(RAY_BATCH, len(starts) - k)
+            hits = p.rayTestBatch(starts[k : k + n], ends[k : k + n], physicsClientId=self.client)
+            if len(hits) != n:  # the ranges it left unwritten would be published as they are: garbage
+                raise RuntimeError(f"pybullet's rayTestBatch returned {len(hits)} results for {n} rays")
             noise = None if z is None else (c.noise_stddev, z[k : k + len(hits)])
             ranges_from_hits(hits, ranges[k : k + len(hits)], limits, noise)
         if c.noise_mean != 0:
@@ -533,9 +545,20 @@ class P3d(Sensor):
 KINDS = {"laser": Lidar, "multilayer": Lidar, "imu": Imu, "gps": Gnss, "camera": Camera, "depth": Camera, "p3d": P3d}
 
 
+@dataclass(frozen=True)
+class MountProblem:
+    """A sensor whose link cannot be mounted on the loaded robot."""
+
+    spec: SensorSpec
+    problem: str
+
+    def __str__(self) -> str:
+        return f"{self.spec.describe()}: {self.problem}"
+
+
 def build_sensors(
     specs, robot, urdf: str, *, seed: int = 0, dt: float, gravity: float = 9.81, datum: Optional[Datum] = None
-) -> Tuple[List[Sensor], List[str]]:
+) -> Tuple[List[Sensor], List[MountProblem]]:
     """The robot's sensors from its specs; (sensors, problems) where a problem names a sensor whose
     link cannot be mounted (the others are kept)."""
     tree = link_tree(urdf)
@@ -544,7 +567,7 @@ def build_sensors(
         try:
             mount = find_mount(tree, robot.joint_index, spec.link, _transform(spec.pose.xyz, spec.pose.rpy))
         except MountError as e:
-            problems.append(f"{spec.describe()}: {e}")
+            problems.append(MountProblem(spec, str(e)))
             continue
         noise = InstantNoise(seed, robot.name, spec.name + "@" + spec.link)
         extra = {}
@@ -555,7 +578,7 @@ def build_sensors(
         elif spec.kind == "p3d" and spec.config.reference_frame != "world":
             ref = spec.config.reference_frame
             if ref not in tree and ref != _root(tree, spec.link):
-                problems.append(f"{spec.describe()}: frameName {ref!r} is neither world nor a link of the robot")
+                problems.append(MountProblem(spec, f"frameName {ref!r} is neither world nor a link of the robot"))
                 continue
             extra["reference"] = Sensor(spec, robot, find_mount(tree, robot.joint_index, ref), noise, dt)
         sensors.append(KINDS[spec.kind](spec, robot, mount, noise, dt, **extra))
@@ -571,7 +594,7 @@ def _root(tree: Dict[str, ParentJoint], link: str) -> str:
 # ---------------------------------------------------------------------------------------------
 # What sensors cost (the simulator's /diagnostics)
 # ---------------------------------------------------------------------------------------------
-OK, WARN = 0, 1  # diagnostic_msgs/DiagnosticStatus levels
+OK, WARN, ERROR = 0, 1, 2  # diagnostic_msgs/DiagnosticStatus levels
 
 
 @dataclass(frozen=True)
@@ -615,3 +638,43 @@ def sensor_report(
     if late:
         return WARN, message + "; cannot hold its rate: " + "; ".join(late), values
     return OK, message, values
+
+
+# ---------------------------------------------------------------------------------------------
+# Sensors a robot goes without (the simulator's /diagnostics)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DisabledSensor:
+    """A sensor the robot goes without: refused at spawn (``since`` None) or disabled when a reading
+    of it failed (``since``: the simulated instant of that reading [s])."""
+
+    name: str  # the sensor's (or model plugin's) name
+    what: str  # the refusal (link, element path, rule) or the sensor and the error its reading raised
+    topics: Tuple[str, ...] = ()  # resolved; none for a block refused before its topics were read
+    since: Optional[float] = None
+
+
+_BLOCK_NAME = re.compile(r"^(?:sensor|plugin)\[@name='([^']*)'\]")
+
+
+def refused_sensors(blocks: Optional[SensorBlocks], problems) -> Tuple[DisabledSensor, ...]:
+    """The sensors a robot spawned without: its refused blocks and its sensors that could not be mounted."""
+    out = []
+    for refused in blocks.refused if blocks is not None else ():
+        match = _BLOCK_NAME.match(refused.path)
+        out.append(DisabledSensor(match.group(1) if match else refused.path, str(refused)))
+    out += [DisabledSensor(problem.spec.name, str(problem)) for problem in problems]
+    return tuple(out)
+
+
+def disabled_report(robot: str, sensor: DisabledSensor) -> Tuple[int, str, Dict[str, str]]:
+    """(level, message, values) of a sensor the robot goes without: an error, as long as the robot is there."""
+    topics = ", ".join(sensor.topics) or "none"
+    if sensor.since is None:
+        message = f"{robot}: sensor {sensor.name} refused at spawn: {sensor.what}"
+    else:
+        message = f"{robot}: sensor {sensor.name} ({topics}) disabled at {sensor.since:.3f} s: {sensor.what}"
+    values = {"robot": robot, "sensor": sensor.name, "topics": topics, "why": sensor.what}
+    if sensor.since is not None:
+        values["disabled at [s]"] = f"{sensor.since:.3f}"
+    return ERROR, message, values

@@ -44,7 +44,10 @@ Sensors: the Gazebo sensor blocks of each robot's description (``model_extras``)
 with the gazebo_ros plugins' topics, frames and parameters (:mod:`thorvald_sim.sensor_blocks`,
 :mod:`thorvald_sim.sensors`, :mod:`thorvald_sim.sensor_io`), each only while somebody subscribes
 to it; a sensor or plugin that is not simulated is logged once at spawn with its name and link,
-and a broken block refuses that sensor with the link, the element path and the rule.
+and a broken block refuses that sensor with the link, the element path and the rule (so does a
+block past the bounds of what one reading may cost, see :mod:`thorvald_sim.sensor_blocks`). A
+sensor whose reading fails is disabled alone (see :mod:`thorvald_sim.sensor_io`); refused and
+disabled sensors are errors on /diagnostics, one status each, as long as their robot is there.
 
 Per robot, in its namespace: subscribes the command topic (``base_state``, as the original plugin,
 or base_driver's ``drive_commands`` with measured drives); publishes ``odometry/gazebo``
@@ -90,7 +93,7 @@ from thorvald_msgs.srv import (
 from .as_built import SimAsBuilt
 from .robot import Pose2D
 from .sensor_io import RobotSensors
-from .sensors import sensor_report
+from .sensors import disabled_report, refused_sensors, sensor_report
 from .simulation import Camera, PerformanceMeter, Simulation, SpawnError, save_png
 from .world import load_world, resolve_world
 
@@ -157,7 +160,9 @@ class RobotIO:
         self.sub = rospy.Subscriber(ns + command_topic, BaseState, self.on_command, queue_size=1)
         self.passive = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
         self.passive_names = [info.name for _, info in robot.passive] + [s.joint for _, s in robot.springs]
-        self.sensors = RobotSensors(robot.sensors, namespace or "/")
+        self.sensors = RobotSensors(
+            robot.sensors, namespace or "/", refused_sensors(robot.sensor_blocks, robot.sensor_problems)
+        )
 
     def on_command(self, msg):
         n = len(self.robot.wheels)
@@ -537,6 +542,7 @@ class SimulatorNode:
                 for name, io in self.io.items()
                 if io.sensors.ios
             ]
+            disabled = [(name, sensor) for name, io in self.io.items() for sensor in io.sensors.disabled()]
         if not self.diagnostics.get_num_connections():
             return
         rtf = perf.real_time_factor
@@ -565,6 +571,12 @@ class SimulatorNode:
         statuses += [
             conversions.diagnostic_status(f"{rospy.get_name()}: sensors of {name}", name, *report)
             for name, report in sensor_reports
+        ]
+        statuses += [
+            conversions.diagnostic_status(
+                f"{rospy.get_name()}: sensor {sensor.name} of {name}", name, *disabled_report(name, sensor)
+            )
+            for name, sensor in disabled
         ]
         msg = DiagnosticArray(status=statuses)
         msg.header.stamp = rospy.Time.from_sec(self.sim.time)
