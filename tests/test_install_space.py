@@ -128,6 +128,7 @@ def test_code_and_package_files_come_from_the_install_space(install):
         "lib/thorvald_base/kinematics",
         "lib/thorvald_model/check_config",
         "lib/thorvald_model/xacro",
+        "lib/thorvald_model/state_publisher",  # model.launch's robot_state_publisher
         "share/thorvald_base/launch/base_bringup.launch",
         "share/thorvald_base/calculator_plugins.xml",
         "share/thorvald_model/urdf/thorvald_model.xacro",
@@ -136,6 +137,8 @@ def test_code_and_package_files_come_from_the_install_space(install):
         "share/thorvald_bringup/config/twist_mux.yaml",
         "lib/thorvald_sim/simulator",
         "lib/thorvald_sim/spawn_robot",
+        "lib/thorvald_sim/check_world",
+        "lib/thorvald_sim/check_as_built",
         "share/thorvald_sim/launch/robot.launch",
         "share/thorvald_sim/worlds/tarmac_gravel.yaml",
         "share/thorvald_model/meshes/hokuyo/hokuyo.dae",

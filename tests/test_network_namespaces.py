@@ -312,10 +312,10 @@ def test_nodes_run_on_their_hosts_with_their_addresses(fleet):
         "/netns_watcher": "r1",
         "/robot_1/base_driver": "r1",
         "/robot_1/twist_mux": "r1",
-        "/robot_1/robot_state_publisher": "r1",
+        "/robot_1/rsp/robot_state_publisher": "r1",
         "/robot_2/base_driver": "r2",
         "/robot_2/twist_mux": "r2",
-        "/robot_2/robot_state_publisher": "r2",
+        "/robot_2/rsp/robot_state_publisher": "r2",
         "/netns_operator": "op",
     }
     for name, key in expected.items():

@@ -19,7 +19,8 @@ Private parameters besides the configuration:
                                    ``simple_sim`` with simple_sim true, else ``can``
 ``~tf_prefix``                     prefix of frame and joint names: ``robot_1/`` or the older
                                    original's ``robot_1``, both giving ``robot_1/base_link``
-``~enable_odom_tf``                broadcast odom -> base_link (default true)
+``~enable_odom_tf``                broadcast odom -> base_link (default true): the transform of the
+                                   odometry it publishes (with passthrough, the simulator's)
 ``~odom_frame_id``                 default ``odom``
 ``~passthrough_gazebo_odometry``   republish ``odometry/gazebo`` (a simulator's ground truth)
                                    on ``odometry/base_raw`` once it arrives (default false)
@@ -307,6 +308,8 @@ class BaseDriverNode:
         msg.header.frame_id = self.odom_frame
         self.gazebo_odom = msg
         self.odom_pub.publish(msg)
+        if self.tf is not None:  # the transform follows the odometry published, whichever it is
+            self.tf.sendTransform(conversions.odometry_transform(msg))
 
     def on_device_frame(self, msg):
         try:

@@ -15,7 +15,9 @@ Private parameters:
 ``~max_lag``              the simulator waits for a robot whose commands lag more than this behind
                           simulated time [s] (0.05; 0: never): a busy machine slows the
                           simulation instead of letting robots drive on stale commands
-``~publish_tf``           default for robots: tf odom -> base_link from ground truth (false)
+``~publish_tf``           default for robots: tf odom -> base_link from ground truth (true, as
+                          the Gazebo plugin's users had it; spawn_robot's -no_publish_tf or
+                          -publish_tf choose per robot)
 ``~tyre_contact_width``   width of the wheels' collision discs [m] (0.01; see robot.py)
 ``~paused``               start paused (false)
 ``~diagnostics_rate``     /diagnostics per wall second [Hz] (1; 0: none): the real-time factor
@@ -55,6 +57,12 @@ or base_driver's ``drive_commands`` with measured drives); publishes ``odometry/
 base_link), ``joint_states`` of the joints base_driver does not report (casters, support wheels,
 suspension) and ``drive_states`` (thorvald_msgs/BaseState: what each drive's encoders measure).
 
+Per robot, unless its spawn or ``~publish_tf`` say no, ``/tf`` carries ``<tf_prefix>odom ->
+<tf_prefix>base_link`` from ground truth, the transform of ``odometry/gazebo``. Another node publishing
+that transform too (base_driver with ``enable_odom_tf``, an EKF in the odom frame) would make the tree
+flicker between the two: the simulator finds it on ``/tf`` (:mod:`thorvald_sim.tf_watch`), leaves the
+transform to it and says so once, naming both publishers.
+
 Services: ``~pause``, ``~unpause``, ``~reset`` (std_srvs/Empty, as Gazebo's), ``~spawn_robot``,
 ``~delete_robot``, ``~snapshot`` (thorvald_msgs). The node publishes ``/clock``, so everything with
 ``/use_sim_time`` runs on simulated time (its own pacing is on the wall clock), and ``/diagnostics``.
@@ -68,6 +76,7 @@ import threading
 import time
 
 import pybullet as p
+import rosgraph
 import rospy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from nav_msgs.msg import Odometry
@@ -95,6 +104,7 @@ from .robot import Pose2D
 from .sensor_io import RobotSensors
 from .sensors import disabled_report, refused_sensors, sensor_report
 from .simulation import Camera, PerformanceMeter, Simulation, SpawnError, save_png
+from .tf_watch import TfWatch
 from .world import load_world, resolve_world
 
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
@@ -102,6 +112,7 @@ MAX_WAIT = 0.5  # [s] wall: the longest the simulator waits at once for a laggin
 STREAM_ALIVE = 1.0  # [s] wall: a robot whose commands stopped this long ago is not waited for
 LOCKSTEP_TIMEOUT = 2.0  # [s] wall: a robot in lockstep that has not answered for this long is let go
 EXIT_REFUSED = 1
+TF_POLL = 2.0  # [s] wall: how often the master is asked who publishes /tf (another odom -> base_link)
 CATCH_UP = 0.05  # [s] wall: behind the pace by more than this (a stall, a busy machine), the pace starts
 # again from now instead of racing to catch up: a burst would read as faster than asked
 
@@ -216,17 +227,20 @@ class RobotIO:
                 if self.command_time == since:
                     self.command_time = None
 
-    def publish_odometry(self, stamp, tf):
-        """odometry/gazebo (and its tf), joint_states of the passive joints: only what somebody reads."""
-        if self.odom_pub.get_num_connections() or (self.publish_tf and tf.get_num_connections()):
-            self._publish_odometry(stamp, tf)
+    def publish_odometry(self, stamp, tf_read: bool):
+        """odometry/gazebo, joint_states of the passive joints: only what somebody reads; the transform of
+        odometry/gazebo for /tf if tf_read and this robot publishes it, else None."""
+        transform = None
+        if self.odom_pub.get_num_connections() or (self.publish_tf and tf_read):
+            transform = self._publish_odometry(stamp, tf_read)
         if self.passive and self.joint_pub.get_num_connections():
             states = self.robot.joint_states(self.passive)
             self.joint_pub.publish(
                 conversions.joint_state_msg(stamp, self.passive_names, [s[0] for s in states], [s[1] for s in states])
             )
+        return transform
 
-    def _publish_odometry(self, stamp, tf):
+    def _publish_odometry(self, stamp, tf_read: bool):
         d = self.robot.description
         position, orientation = self.robot.odom_pose()
         linear, angular = self.robot.body_twist()
@@ -240,8 +254,7 @@ class RobotIO:
             angular=angular,
         )
         self.odom_pub.publish(msg)
-        if self.publish_tf and tf.get_num_connections():
-            tf.publish(TFMessage([conversions.odometry_transform(msg)]))
+        return conversions.odometry_transform(msg) if self.publish_tf and tf_read else None
 
     def publish_drives(self, stamp):
         if self.drive_pub.get_num_connections():  # base_driver with measured drives
@@ -274,7 +287,7 @@ class SimulatorNode:
         drive_state_rate = positive("drive_state_rate", 100.0)
         self.command_timeout = positive("command_timeout", 0.5)
         self.max_lag = positive("max_lag", 0.05, allow_zero=True)
-        self.default_tf = bool(rospy.get_param("~publish_tf", False))
+        self.default_tf = bool(rospy.get_param("~publish_tf", True))
         tyre = positive("tyre_contact_width", 0.01)
         self.paused = bool(rospy.get_param("~paused", False))
         diagnostics_rate = positive("diagnostics_rate", 1.0, allow_zero=True)
@@ -297,6 +310,11 @@ class SimulatorNode:
         # cost more than the physics; a blocking write froze the simulation when one reader's link dropped.
         self.clock_pub = NonBlockingPublisher("/clock", Clock)
         self.tf = NonBlockingPublisher("/tf", TFMessage)
+        self.tf_watch = TfWatch(rospy.get_name())
+        self.tf_reader = None  # the /tf subscription while TfWatch has publishers to judge
+        self.tf_conflicts_said = set()  # robots whose other publisher of odom -> base_link was warned about
+        self.tf_poll_now = threading.Event()  # a spawn: look at /tf's publishers now, not at the next poll
+        threading.Thread(target=self.watch_tf, name="tf_watch", daemon=True).start()
         self.diagnostics = NonBlockingPublisher("/diagnostics", DiagnosticArray)
         self.meter = PerformanceMeter(1.0 / diagnostics_rate) if diagnostics_rate else None
         rospy.Service("~pause", Empty, self.srv_pause)
@@ -368,10 +386,18 @@ class SimulatorNode:
                     )
             self.say_sensors(req.model_name, robot)
             topic = req.command_topic or robot.description.command_topic
-            tf = self.default_tf if req.publish_tf < 0 else bool(req.publish_tf)
+            # by default a robot with the generator's block (odometry/gazebo's frames), not a passive model:
+            # a post's "odom -> base_link" would be another robot's
+            tf = self.default_tf and bool(robot.description.drives) if req.publish_tf < 0 else bool(req.publish_tf)
             self.io[req.model_name] = RobotIO(self, robot, req.robot_namespace, topic, tf)
+            if tf:
+                self.tf_watch.watch(req.model_name, robot.description.base_frame)
+                self.tf_poll_now.set()
         kind = f"{len(robot.wheels)} drives following {topic}" if robot.wheels else "passive (no drive block)"
         message = f"spawned {req.model_name} in {req.robot_namespace or '/'} at ({req.x:g}, {req.y:g}), {kind}"
+        if tf:
+            d = robot.description
+            message += f", {d.odometry_frame} -> {d.base_frame} on /tf from ground truth"
         if as_built is not None:
             message += f", as built: {as_built.source}"
         rospy.loginfo("simulator: %s", message)
@@ -404,6 +430,7 @@ class SimulatorNode:
             except SpawnError as e:
                 return DeleteRobotResponse(False, str(e))
             self.io.pop(req.model_name).close()
+            self.tf_watch.forget(req.model_name)
         return DeleteRobotResponse(True, f"deleted {req.model_name}")
 
     def srv_snapshot(self, req):
@@ -519,11 +546,75 @@ class SimulatorNode:
         if ticked:
             self.publish_clock()
         if self.odometry.due(now):
-            for io in self.io.values():
-                io.publish_odometry(stamp, self.tf)
+            tf_read = self.tf.get_num_connections() > 0
+            transforms = [io.publish_odometry(stamp, tf_read) for io in self.io.values()]
+            transforms = [t for t in transforms if t is not None]
+            if transforms:  # every robot's in one message: one write per tf reader, not one per robot
+                self.tf.publish(TFMessage(transforms))
         for io in self.io.values():
             io.sensors.step(now)
         return ticked
+
+    # ---- other publishers of the robots' transforms ---------------------------------------------
+    def watch_tf(self):
+        """Every TF_POLL seconds of wall time: the master's /tf publishers to TfWatch, /tf read while it
+        has something to judge, and the robots whose other publisher went silent handed back."""
+        master = rosgraph.Master(rospy.get_name())
+        while not rospy.is_shutdown():
+            try:
+                publishers = dict(master.getSystemState()[0]).get("/tf", [])
+            except Exception as e:  # the master went away: nothing to judge until it is back
+                rospy.logdebug("simulator: cannot ask the master for /tf's publishers: %s", e)
+                publishers = []
+            self.tf_watch.publishers(publishers)
+            for conflict in self.tf_watch.resumed(time.monotonic()):
+                io = self.io.get(conflict.robot)
+                if io is not None:
+                    io.publish_tf = True
+                    rospy.loginfo(
+                        "simulator: %s: %s stopped publishing %s -> %s: the simulator publishes it again",
+                        conflict.robot,
+                        conflict.publisher,
+                        conflict.parent,
+                        conflict.child,
+                    )
+            listening = self.tf_watch.listening()
+            if listening and self.tf_reader is None:
+                self.tf_reader = rospy.Subscriber("/tf", rospy.AnyMsg, self.on_tf, queue_size=50)
+            elif not listening and self.tf_reader is not None:
+                self.tf_reader.unregister()
+                self.tf_reader = None
+            self.tf_poll_now.wait(TF_POLL)
+            self.tf_poll_now.clear()
+
+    def on_tf(self, msg):
+        caller = msg._connection_header.get("callerid", "")
+        for conflict in self.tf_watch.message(caller, msg._buff, time.monotonic()):
+            io = self.io.get(conflict.robot)
+            if io is None:
+                continue
+            io.publish_tf = False
+            if conflict.robot in self.tf_conflicts_said:
+                rospy.loginfo(
+                    "simulator: %s: %s publishes %s -> %s again: the simulator leaves it to it",
+                    conflict.robot,
+                    conflict.publisher,
+                    conflict.parent,
+                    conflict.child,
+                )
+                continue
+            self.tf_conflicts_said.add(conflict.robot)
+            rospy.logwarn(
+                "simulator: %s: %s publishes %s -> %s on /tf, and so does the simulator (%s, from ground truth): "
+                "the simulator leaves it to %s while it does, so the tree does not flicker between the two "
+                "(spawn with -no_publish_tf, or give base_driver enable_odom_tf:=false, to choose one yourself)",
+                conflict.robot,
+                conflict.publisher,
+                conflict.parent,
+                conflict.child,
+                rospy.get_name(),
+                conflict.publisher,
+            )
 
     def publish_performance(self, wall: float) -> None:
         """/diagnostics once per ~diagnostics_rate period of wall time: the real-time factor reached, and
