@@ -38,6 +38,7 @@ from nav_msgs.msg import Odometry
 from thorvald_base.conversions import quaternion_yaw
 from thorvald_model import load_robot_config
 from thorvald_model.layout import common_axle
+from thorvald_testing.topics import Latest
 
 SPEED = 0.5  # [m/s] forward
 TURN_RATE = 0.5  # [rad/s]
@@ -85,24 +86,6 @@ def delta(start: Sequence[float], end: Sequence[float]) -> Tuple[float, float, f
     dx, dy = end[0] - start[0], end[1] - start[1]
     direction = math.remainder(math.atan2(dy, dx) - start[2], 2 * math.pi)
     return math.hypot(dx, dy), direction, math.remainder(end[2] - start[2], 2 * math.pi)
-
-
-class Latest:
-    """The latest message of a topic."""
-
-    def __init__(self, topic, msg_type):
-        self.topic = topic
-        self.msg = None
-        self._lock = threading.Lock()
-        self.sub = rospy.Subscriber(topic, msg_type, self._on, queue_size=10)
-
-    def _on(self, msg):
-        with self._lock:
-            self.msg = msg
-
-    def get(self):
-        with self._lock:
-            return self.msg
 
 
 class Commanders:

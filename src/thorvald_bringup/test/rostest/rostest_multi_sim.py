@@ -13,23 +13,10 @@ import tf2_ros
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
+from thorvald_testing.topics import Latest, TfPublishers
+
 STARTUP = 90.0  # [s] of wall time for four robots to come up on a busy machine
 SPAWN = {"robot_1": (2.5, 2.5), "robot_2": (2.5, -2.5), "robot_3": (-2.5, 2.5), "robot_4": (-2.5, -2.5)}
-
-
-class Latest:
-    def __init__(self, topic):
-        self.msg = None
-        self.lock = threading.Lock()
-        rospy.Subscriber(topic, Odometry, self.on, queue_size=1)
-
-    def on(self, msg):
-        with self.lock:
-            self.msg = msg
-
-    def get(self):
-        with self.lock:
-            return self.msg
 
 
 def position(msg):
@@ -47,7 +34,8 @@ def sim_sleep(seconds):
 class MultiSimTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.truth = {r: Latest(f"/{r}/odometry/gazebo") for r in SPAWN}
+        cls.tf_publishers = TfPublishers()
+        cls.truth = {r: Latest(f"/{r}/odometry/gazebo", Odometry, queue_size=1) for r in SPAWN}
         cls.pubs = {r: rospy.Publisher(f"/{r}/nav_vel", Twist, queue_size=1) for r in SPAWN}
         deadline = time.time() + STARTUP
         while time.time() < deadline and not all(
@@ -104,6 +92,15 @@ class MultiSimTest(unittest.TestCase):
             base = position(self.truth[r].get())
             wheel = (t.transform.translation.x, t.transform.translation.y)
             self.assertLess(math.dist(wheel, (x + base[0], y + base[1])), 1.5, f"{r}/wheel0_link far from its robot")
+
+    def test_one_publisher_per_transform(self):
+        """robot_state_publisher's (model.launch's, or fleet_driver's), the simulator's odom -> base_link
+        and the world -> odom transforms: every frame published by one node, on one topic."""
+        sim_sleep(2.0)
+        children = self.tf_publishers.children()
+        for r in SPAWN:
+            self.assertTrue({f"{r}/base_link", f"{r}/leg0", f"{r}/odom"} <= children, f"{r}: {sorted(children)}")
+        self.assertEqual(self.tf_publishers.shared(), {})
 
 
 if __name__ == "__main__":

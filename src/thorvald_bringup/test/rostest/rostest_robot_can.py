@@ -9,7 +9,6 @@ robot) and robot_state_publisher the robot's links from the model robot.launch l
 time, as a real robot runs.
 """
 
-import threading
 import time
 import unittest
 
@@ -21,24 +20,11 @@ from nav_msgs.msg import Odometry
 
 from thorvald_msgs.msg import BaseState, ControllerArray
 from thorvald_testing import poll
+from thorvald_testing.topics import Latest
 
 STARTUP = 60.0  # [s]: the emulator, base_driver's respawn and SLCAN's 2 s open on a busy machine
 SPEED = 0.3  # [m/s]
 DRIVE = 3.0  # [s]
-
-
-class Latest:
-    def __init__(self, topic, msg_type):
-        self.msg, self.count, self.lock = None, 0, threading.Lock()
-        rospy.Subscriber(topic, msg_type, self.on, queue_size=10)
-
-    def on(self, msg):
-        with self.lock:
-            self.msg, self.count = msg, self.count + 1
-
-    def get(self):
-        with self.lock:
-            return self.msg
 
 
 class RobotOverCanTest(unittest.TestCase):

@@ -31,6 +31,8 @@ from nav_msgs.msg import Odometry
 from sensor_msgs import point_cloud2
 from sensor_msgs.msg import LaserScan, PointCloud2
 
+from thorvald_testing.topics import Latest, TfPublishers
+
 STARTUP = 120.0  # [s] wall: the simulator, the model and the spawn on a busy machine
 WALLS_X = (-3.9, 7.9)  # [m] the yard's inner faces in odom (the robot spawns at the origin)
 WALLS_Y = (-2.9, 4.9)
@@ -73,31 +75,6 @@ def distance_to_walls(points):
     return np.min(np.abs(np.column_stack([x - WALLS_X[0], x - WALLS_X[1], y - WALLS_Y[0], y - WALLS_Y[1]])), axis=1)
 
 
-class Latest:
-    def __init__(self, topic, kind):
-        self.msg = None
-        self.lock = threading.Lock()
-        self.sub = rospy.Subscriber(topic, kind, self.on, queue_size=1, buff_size=2**24)
-
-    def on(self, msg):
-        with self.lock:
-            self.msg = msg
-
-    def get(self):
-        with self.lock:
-            return self.msg
-
-    def after(self, stamp, timeout=30.0):
-        """The first message stamped at or after stamp [rospy.Time]."""
-        deadline = time.time() + timeout
-        while time.time() < deadline and not rospy.is_shutdown():
-            msg = self.get()
-            if msg is not None and msg.header.stamp >= stamp:
-                return msg
-            time.sleep(0.02)
-        raise AssertionError(f"nothing on {self.sub.resolved_name} stamped after {stamp.to_sec():.2f} s")
-
-
 class UsersTfTree(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -106,10 +83,11 @@ class UsersTfTree(unittest.TestCase):
         cls.base = rospy.get_param("~base")
         cls.buffer = tf2_ros.Buffer(rospy.Duration(30.0))
         cls.listener = tf2_ros.TransformListener(cls.buffer)
-        cls.scan = Latest(rospy.get_param("~scan"), LaserScan)
+        cls.tf_publishers = TfPublishers()
+        cls.scan = Latest(rospy.get_param("~scan"), LaserScan, queue_size=1, buff_size=2**24)
         cloud = rospy.get_param("~cloud", "")
-        cls.cloud = Latest(cloud, PointCloud2) if cloud else None
-        cls.truth = Latest(cls.ns + "odometry/gazebo", Odometry)
+        cls.cloud = Latest(cloud, PointCloud2, queue_size=1, buff_size=2**24) if cloud else None
+        cls.truth = Latest(cls.ns + "odometry/gazebo", Odometry, queue_size=1)
         cls.nav = rospy.Publisher(cls.ns + "nav_vel", Twist, queue_size=1)
         deadline = time.time() + STARTUP
         while time.time() < deadline and (cls.truth.get() is None or cls.scan.get() is None):
@@ -136,6 +114,9 @@ class UsersTfTree(unittest.TestCase):
         names = set(frames) | {f["parent"] for f in frames.values()}
         self.assertEqual([n for n in names if n.startswith("/") or "//" in n], [])
         self.assertEqual(frames[self.base]["parent"], self.odom)
+        # one publisher per transform: model.launch's robot_state_publisher, the simulator's odom -> base_link
+        self.assertEqual(self.tf_publishers.shared(), {})
+        self.assertIn(self.base, self.tf_publishers.children())
 
     def test_2_every_sensor_frame_hangs_from_odom_and_its_readings_lie_on_the_walls(self):
         scan = self.scan.get()
@@ -143,7 +124,7 @@ class UsersTfTree(unittest.TestCase):
         self.assertIn(scan.header.frame_id, self.links)
         self.check_scan_on_walls(scan)
         if self.cloud is not None:
-            cloud = self.cloud.after(rospy.Time(0), timeout=STARTUP)
+            cloud = self.cloud.wait(timeout=STARTUP)
             self.assertFalse(cloud.header.frame_id.startswith("/"), cloud.header.frame_id)
             self.assertIn(cloud.header.frame_id, self.links)
             m = matrix(self.lookup(self.odom, cloud.header.frame_id, cloud.header.stamp))
@@ -203,7 +184,7 @@ class UsersTfTree(unittest.TestCase):
         self.assertGreater(len(ahead), 0)
         # the wall ahead, seen from base_link: where ground truth puts the robot in the yard, the
         # first inner face along its heading
-        truth = self.truth.after(scan.header.stamp).pose.pose
+        truth = self.truth.after(scan.header.stamp, timeout=30.0).pose.pose
         yaw = 2 * math.atan2(truth.orientation.z, truth.orientation.w)
         c, s = math.cos(yaw), math.sin(yaw)
         hits = []

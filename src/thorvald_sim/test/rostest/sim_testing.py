@@ -14,6 +14,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from thorvald_base.conversions import quaternion_yaw
+from thorvald_testing import topics
 
 STARTUP = 120.0  # [s] wall, for the simulator, the robots' nodes and their spawns on a busy machine
 WALL_LIMIT = 120.0  # [s] wall, for a test's simulated wait
@@ -34,32 +35,14 @@ def delta(start, end):
     return math.hypot(dx, dy), math.remainder(direction, 2 * math.pi), turn
 
 
-class Latest:
-    """The latest message of a topic, and when (simulated time) it came."""
+class Latest(topics.Latest):
+    """thorvald_testing's Latest, of Odometry unless told, waiting STARTUP by default."""
 
     def __init__(self, topic, msg_type=Odometry):
-        self.topic = topic
-        self._lock = threading.Lock()
-        self.msg = None
-        self.count = 0
-        self.sub = rospy.Subscriber(topic, msg_type, self._on, queue_size=10)
-
-    def _on(self, msg):
-        with self._lock:
-            self.msg = msg
-            self.count += 1
-
-    def get(self):
-        with self._lock:
-            return self.msg
+        super().__init__(topic, msg_type)
 
     def wait(self, timeout=STARTUP):
-        deadline = time.time() + timeout
-        while time.time() < deadline and not rospy.is_shutdown():
-            if self.get() is not None:
-                return self.get()
-            time.sleep(0.02)
-        raise AssertionError(f"nothing on {self.topic} within {timeout:.0f} s")
+        return super().wait(timeout)
 
 
 def sim_sleep(seconds):
