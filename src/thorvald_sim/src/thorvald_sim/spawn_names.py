@@ -1,4 +1,4 @@
-"""The names a robot is spawned under: its model name and its namespace, each a legal ROS name.
+"""The names a robot is spawned under: its model name (as Gazebo's) and its namespace (a legal ROS name).
 
 The model name names the robot in the world, in the simulator's log lines and diagnostics, and in
 the services that delete or move it; the namespace is where its topics live. Both come from a
@@ -6,6 +6,7 @@ spawn request that any client may send, so the simulator's spawn service checks 
 spawn_robot does. The rules are ROS's own (rosgraph.names, plain string rules: no master, no rospy).
 """
 
+import re
 from typing import Any, Optional
 
 import rosgraph.names
@@ -13,16 +14,24 @@ import rosgraph.names
 from thorvald_model.value_text import value_text
 
 SHOWN = 60  # [characters] of a refused name shown in a message
+MAX_MODEL_NAME = 255  # [characters]
+_MODEL_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*\Z")
 
 
 def model_name_problem(name: Any) -> Optional[str]:
-    """None if name may name a robot in the world, else the message saying why not."""
+    """None if name may name a robot in the world, else the message saying why not.
+
+    Model names are Gazebo's, not ROS names (``robot-1`` and ``unit_box.0`` are fine): letters, digits,
+    ``_``, ``-`` and ``.``, not starting with ``-`` or ``.``, at most MAX_MODEL_NAME characters; no
+    blank, slash or control character, which would break the log lines, diagnostics and services
+    that name the robot."""
     if not isinstance(name, str) or not name:
         return "a robot needs a name: -model NAME"
-    if not rosgraph.names.is_legal_base_name(name):
+    if len(name) > MAX_MODEL_NAME or not _MODEL_NAME.match(name):
         return (
-            f"model name {value_text(name, SHOWN)}: must be a ROS base name, a letter then letters, digits and "
-            "underscores (it names the robot in log lines, diagnostics and services)"
+            f"model name {value_text(name, SHOWN)}: must be letters, digits, '_', '-' and '.', starting with a "
+            f"letter, digit or '_', at most {MAX_MODEL_NAME} characters (it names the robot in log lines, "
+            "diagnostics and services)"
         )
     return None
 

@@ -6,8 +6,8 @@ is that namespace's parameter, and the robot's topics live there.
 
   -param P | -file F     the URDF: a parameter (relative to the namespace) or a file
   -urdf                  accepted (the description is always URDF)
-  -model NAME            the robot's name in the world: a ROS base name (a letter, then letters,
-                         digits and underscores)
+  -model NAME            the robot's name in the world, as Gazebo's: letters, digits, '_', '-', '.'
+                         (not first: '-', '.')
   -x X -y Y -z Z -Y YAW  base_link's spawn pose [m, rad]; -R and -P (roll, pitch) must be 0
   -robot_namespace NS    where its topics live (default: this node's namespace): a legal ROS name,
                          not private (~)
@@ -60,7 +60,7 @@ def parse_args(argv: List[str]) -> argparse.Namespace:
         "-model",
         required=True,
         type=_checked(model_name_problem),
-        help="the robot's name in the world (a ROS base name)",
+        help="the robot's name in the world (letters, digits, '_', '-', '.')",
     )
     for axis in ("x", "y", "z", "R", "P", "Y"):
         parser.add_argument("-" + axis, type=float, default=0.0)
