@@ -389,7 +389,7 @@ def test_link_cut_stops_the_wheels_and_restoring_it_gives_control_back(fleet, si
     cmd_topic, truth_topic = f"/{robot}/twist_mux/cmd_vel", f"/{robot}/odometry/gazebo"
     timeout = float(fleet.param(f"/{robot}/base_driver/command_timeout", 0.5))
     cycle = 1.0 / float(fleet.param(f"/{robot}/base_driver/rate", 50.0))
-    tick = 1.0 / float(fleet.param("/simulator/clock_rate", 100.0))
+    tick = 1.0 / float(fleet.param("/simulator/clock_rate", 80.0))
     accel = float(fleet.param(f"/{robot}/base_driver/motor_drives/drive0/prp_sim_a"))
     odometry_rate = float(fleet.param("/simulator/odometry_rate", 50.0))
     pids = fleet.node_pids()

@@ -55,7 +55,6 @@ A bad configuration, calibration file or parameter stops the node at start with 
 it (the file, the key path, the value and the rule), exit status 1.
 """
 
-import math
 import sys
 import threading
 import time
@@ -80,7 +79,7 @@ from thorvald_msgs.srv import (
 )
 
 from . import conversions
-from .bases import create_base_handle
+from .bases import create_base_handle, handle_class, handle_class_named, known_handles
 from .bases.handle import DriveTopics, Ports
 from .calibration import load_calibration
 from .core import BaseDriverCore, PoseCovariance
@@ -89,6 +88,7 @@ from .errors import ParameterError, ThorvaldBaseError
 from .node_names import Names, Throttle
 from .params import PARAMETER_NAMES, DriverParams
 from .plugins import load_calculator
+from .rate_grid import RateGrid
 from .stamped_commands import StampedCommands
 
 STATUS_PERIOD = 1.0  # [s] between battery_data / motor_controller_data messages
@@ -167,9 +167,11 @@ class BaseDriverNode:
         self.enable_tf = params.enable_odom_tf
         self.rate = params.rate
         self.lockstep = params.lockstep
-        if self.lockstep and params.handle != "simulated_joints":
+        if self.lockstep and not handle_class(params).supports_lockstep:
+            lockstep_handles = ", ".join(n for n in known_handles() if handle_class_named(n).supports_lockstep)
             raise ParameterError(
-                f"~lockstep: true needs ~base_handle simulated_joints (the simulator's drives), not {params.handle}"
+                f"~lockstep: true needs a base handle that answers a simulator instant by instant ({lockstep_handles}),"
+                f" not {params.handle}"
             )
         self.covariance = PoseCovariance(params.twist_covariance)
         calculator = load_calculator(self.config, estimator=params.estimator, projection=params.projection)
@@ -400,15 +402,14 @@ class BaseDriverNode:
         runs (and two robots) cycle at the same instants; what a cycle sees is the states of its
         instant, never an older or a newer one."""
         handle = self.core.handle
-        period = 1.0 / self.rate
-        last, next_cycle = None, -math.inf
+        cycles = RateGrid(self.rate)  # the simulator's ticks are the instants: exact multiples count
+        last = None
         while not rospy.is_shutdown():
             t = handle.wait_for_states(last, 0.2)
             if t is None:
                 continue
             last = t
-            if t >= next_cycle - 1e-9:
-                next_cycle = (math.floor(t / period + 1e-9) + 1) * period
+            if cycles.due(t):
                 stamp = rospy.Time.from_sec(t)
                 twist = self.stamped_command(t)
                 with self.lock:

@@ -247,3 +247,15 @@ def test_simulated_joints_give_a_cycle_the_states_of_its_instant_not_newer_ones(
     assert base.read_drive_states(1.05) == at[1.02]
     base.update(at[1.0], 0.5)  # simulated time went back: the newest is all there is
     assert base.read_drive_states(0.5) == at[1.0]
+
+
+def test_lockstep_is_a_property_of_the_handle_and_those_that_claim_it_can_wait_and_answer():
+    from thorvald_base.bases import BASE_HANDLES, BaseHandle, handle_class_named  # noqa: PLC0415
+
+    claims = {name: handle_class_named(name).supports_lockstep for name in BASE_HANDLES}
+    assert claims == {"simple_sim": False, "simulated_joints": True, "can": False}
+    for name, claimed in claims.items():
+        cls = handle_class_named(name)
+        if claimed:  # the lockstep loop's two calls, implemented by the handle itself
+            assert cls.wait_for_states is not getattr(BaseHandle, "wait_for_states", None)
+            assert callable(cls.wait_for_states) and callable(cls.answer)

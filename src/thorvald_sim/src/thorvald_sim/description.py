@@ -19,9 +19,7 @@ from thorvald_model.joint_tree import Origin, ParentJoint, UrdfError  # noqa: F4
 from thorvald_model.joint_tree import link_tree as _link_tree
 from thorvald_model.urdf_check import normalize_frame
 
-
-class DescriptionError(Exception):
-    """A robot description the simulator cannot use; the message says why."""
+from .errors import DescriptionError
 
 
 @dataclass(frozen=True)

@@ -49,7 +49,7 @@ bytes), its client copies RGBA, depth and segmentation (12 bytes) and pybullet h
 numpy arrays (12 bytes more); it counts those bytes in C ``int``, which overflows past 2^29 pixels
 (a 100000 x 100000 camera is 10^10). A lidar's rays go to pybullet 16383 at a time, so a reading's
 time grows with its rays alone. Nothing else a block sets scales a reading's cost: a rate above the
-physics rate is read once a step (:class:`thorvald_sim.sensors.Schedule`; the simulator's
+physics rate is read once a step (:class:`thorvald_base.rate_grid.RateGrid`; the simulator's
 /diagnostics warns of it), and a ray's length costs nothing more (2000 rays over a height field
 cost the same from 30 m to 10^9 m).
 
@@ -66,6 +66,8 @@ from typing import Dict, List, Optional, Tuple
 from thorvald_model.datum import Datum
 from thorvald_model.joint_tree import Origin as Pose  # a transform: SDF's <pose> is URDF's <origin>
 from thorvald_model.urdf_check import normalize_frame
+
+from .errors import BlockError
 
 Vec3 = Tuple[float, float, float]
 
@@ -225,13 +227,6 @@ class SensorBlocks:
     sensors: Tuple[SensorSpec, ...] = ()
     unsupported: Tuple[Unsupported, ...] = ()
     refused: Tuple[Refused, ...] = ()
-
-
-class BlockError(Exception):
-    def __init__(self, path: str, rule: str):
-        super().__init__(f"{path}: {rule}")
-        self.path = path
-        self.rule = rule
 
 
 # ---------------------------------------------------------------------------------------------

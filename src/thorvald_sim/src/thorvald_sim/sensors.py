@@ -46,9 +46,11 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 import pybullet as p
 
+from thorvald_base.rate_grid import RateGrid
 from thorvald_model.datum import WGS84_A, WGS84_E2, earth_radii  # noqa: F401  (the constants: for tests)
 
 from .description import ParentJoint, link_tree
+from .errors import MountError
 from .sensor_blocks import (
     CameraConfig,
     Datum,
@@ -113,10 +115,6 @@ def ranges_from_hits(
     out[:n] = np.where(fractions >= 1.0, np.inf, range_min + fractions * (range_max - range_min))
     if z is not None:
         out[:n] += stddev * z[:n]
-
-
-class MountError(Exception):
-    """A sensor's link cannot be found on the loaded robot."""
 
 
 def _transform(xyz: Vec3, rpy: Vec3) -> Transform:
@@ -208,29 +206,6 @@ class InstantNoise:
         return draws[slot]
 
 
-class Schedule:
-    """The instants of a rate [Hz] on simulated time: the multiples of its period (the same whenever
-    the sensor began to be read); rate 0: every physics step."""
-
-    def __init__(self, rate: float):
-        self.period = 1.0 / rate if rate > 0 else 0.0
-        self.next: Optional[int] = None  # the index of the next instant on the grid
-
-    def due(self, now: float, dt: float) -> bool:
-        if self.period == 0.0:
-            return True
-        if self.next is None or self.next * self.period < now - self.period - dt:
-            # first reading, or again after nobody read it: from the grid's next instant on
-            self.next = math.ceil((now - dt / 2) / self.period)
-        if now + dt / 2 < self.next * self.period:
-            return False
-        self.next += 1
-        return True
-
-    def pause(self) -> None:
-        self.next = None
-
-
 class Sensor:
     """One sensor on one robot. ``read(now)`` measures and returns a reading (see the subclasses)."""
 
@@ -242,7 +217,7 @@ class Sensor:
         self.rng = noise.at(0)  # repositioned at each reading's instant by due()
         self.reading = 0  # the reading's index on the schedule's grid (the physics step's at rate 0), by due()
         self.dt = dt
-        self.schedule = Schedule(spec.rate)
+        self.schedule = RateGrid(spec.rate, dt)  # a rate above the physics rate: once a step
 
     @property
     def client(self) -> int:
@@ -250,11 +225,10 @@ class Sensor:
 
     def due(self, now: float) -> bool:
         """Whether a reading is due at now; if so, the noise is that instant's."""
-        if not self.schedule.due(now, self.dt):
+        if not self.schedule.due(now):
             return False
-        instant = round(now / self.dt)
-        self.rng = self.noise.at(instant)
-        self.reading = self.schedule.next - 1 if self.schedule.period else instant
+        self.rng = self.noise.at(round(now / self.dt))
+        self.reading = self.schedule.index  # the multiple of the period served (the step's, at rate 0)
         return True
 
     def pose(self) -> Transform:

@@ -15,6 +15,7 @@ from thorvald_model.urdf_check import UrdfCheckError, checked_urdf
 
 from .as_built import SimAsBuilt
 from .description import DescriptionError, MeshFinder, mesh_finder, parse_description, resolve_meshes
+from .errors import SpawnError
 from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
 from .scene import build_scene
 from .sensor_blocks import Datum, read_sensor_blocks
@@ -32,10 +33,6 @@ def installed_package_path(package: str) -> Optional[str]:
         return rospkg.RosPack().get_path(package)
     except rospkg.ResourceNotFound:
         return None
-
-
-class SpawnError(Exception):
-    """A robot that cannot be spawned (or deleted); the message says why."""
 
 
 @dataclass(frozen=True)

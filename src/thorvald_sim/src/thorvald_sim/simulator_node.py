@@ -1,5 +1,11 @@
 """The ``simulator`` node: one pybullet world, the clock, and per robot the original Gazebo plugin's topics.
 
+The node is wiring: the world and its robots are :class:`thorvald_sim.simulation.Simulation`; the
+loop's parts are pure modules tested with a clock of their own: the parameters read once
+(:mod:`thorvald_sim.params`), real-time pacing (:mod:`thorvald_sim.pacing`), lockstep
+(:mod:`thorvald_sim.lockstep`) and the grid of simulated time every periodic message falls on
+(:mod:`thorvald_base.rate_grid`, the sensors' and base_driver's too).
+
 Private parameters:
 
 ========================  ================================================================
@@ -8,9 +14,10 @@ Private parameters:
 ``~gui``                  open pybullet's window (default false: headless)
 ``~physics_rate``         physics steps per simulated second [Hz] (240)
 ``~real_time_factor``     simulated seconds per wall second (1); 0 runs as fast as it can
-``~clock_rate``           /clock messages per simulated second [Hz] (100; at most one a step)
+``~clock_rate``           /clock messages per simulated second [Hz] (80: every third step at 240 Hz
+                          physics; at most one a step)
 ``~odometry_rate``        odometry/gazebo and joint_states per simulated second [Hz] (50)
-``~drive_state_rate``     drive_states per simulated second [Hz] (100)
+``~drive_state_rate``     drive_states per simulated second [Hz] (80)
 ``~command_timeout``      a robot whose commands stop for this long [s] stops its wheels (0.5)
 ``~max_lag``              the simulator waits for a robot whose commands lag more than this behind
                           simulated time [s] (0.05; 0: never): a busy machine slows the
@@ -36,9 +43,9 @@ Lockstep (``~lockstep`` true): with measured drives, the simulator publishes eac
 instant. The run is then the same on an idle and on a busy machine and at any real-time factor. A
 robot joins with the first drive states it publishes to a reader (so the steps before its first
 answer do not depend on how soon that answer came) and is let go, with a warning, when it has not
-answered for ``LOCKSTEP_TIMEOUT`` seconds of wall time (its driver died or stopped, or it reads
-drive states without being in lockstep): the others go on, and it joins again with its next
-command. A run that must repeat from its first instant starts paused (``~paused``), and whoever
+answered for 2 seconds of wall time (:data:`thorvald_sim.lockstep.TIMEOUT`; its driver died or
+stopped, or it reads drive states without being in lockstep): the others go on, and it joins again
+with its next command. A run that must repeat from its first instant starts paused (``~paused``), and whoever
 drives it unpauses once every node is connected (see verification_drive's ``~unpause``). Without
 lockstep the simulator waits only for robots that lag more than ``~max_lag``.
 
@@ -87,6 +94,7 @@ from tf2_msgs.msg import TFMessage
 
 from thorvald_base import conversions
 from thorvald_base.publishing import NonBlockingPublisher
+from thorvald_base.rate_grid import RateGrid
 from thorvald_model import ConfigError
 from thorvald_model.datum import load_datum
 from thorvald_msgs.msg import BaseState
@@ -100,50 +108,22 @@ from thorvald_msgs.srv import (
 )
 
 from .as_built import SimAsBuilt
+from .errors import ParameterError, SpawnError
+from .lockstep import Lockstep
+from .pacing import Pacer
+from .params import SimulatorParams
 from .robot import Pose2D
 from .sensor_io import RobotSensors
 from .sensors import disabled_report, refused_sensors, sensor_report
-from .simulation import Camera, PerformanceMeter, Simulation, SpawnError, save_png
+from .simulation import Camera, PerformanceMeter, Simulation, save_png
 from .tf_watch import TfWatch
 from .world import load_world, resolve_world
 
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
 MAX_WAIT = 0.5  # [s] wall: the longest the simulator waits at once for a lagging robot
 STREAM_ALIVE = 1.0  # [s] wall: a robot whose commands stopped this long ago is not waited for
-LOCKSTEP_TIMEOUT = 2.0  # [s] wall: a robot in lockstep that has not answered for this long is let go
 EXIT_REFUSED = 1
 TF_POLL = 2.0  # [s] wall: how often the master is asked who publishes /tf (another odom -> base_link)
-CATCH_UP = 0.05  # [s] wall: behind the pace by more than this (a stall, a busy machine), the pace starts
-# again from now instead of racing to catch up: a burst would read as faster than asked
-
-
-class ParameterError(Exception):
-    pass
-
-
-def positive(name: str, default: float, allow_zero: bool = False) -> float:
-    value = rospy.get_param("~" + name, default)
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"~{name}: {value!r}: must be a number") from None
-    if not math.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
-        raise ParameterError(f"~{name}: {value!r}: must be {'>= 0' if allow_zero else '> 0'}")
-    return value
-
-
-class Every:
-    """True once per period of simulated time [s] (0: every call)."""
-
-    def __init__(self, rate: float):
-        self.period = 1.0 / rate if rate > 0 else 0.0
-        self.next = 0.0
-
-    def due(self, now: float) -> bool:
-        if now + 1e-9 < self.next:
-            return False
-        self.next = now + self.period if self.period else now
-        return True
 
 
 class RobotIO:
@@ -164,9 +144,6 @@ class RobotIO:
         self.command_stamp = None  # [s] simulated time the command is for (its stamp)
         self.command_wall = None  # [s] wall (monotonic) time it arrived
         self.fresh = False
-        self.awaiting = None  # [s] lockstep: the instant of drive states not answered yet
-        self.in_lockstep = False  # lockstep: it answers (joined with its first drive states read, or command)
-        self.joined = False  # lockstep: it was awaited once (a robot let go joins again by a command only)
         self.node = node
         self.sub = rospy.Subscriber(ns + command_topic, BaseState, self.on_command, queue_size=1)
         self.passive = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
@@ -199,14 +176,8 @@ class RobotIO:
             self.command_stamp = stamp
             self.command_wall = time.monotonic()
             self.fresh = True
-        if self.node.lockstep:
-            with self.node.answered:
-                if not self.in_lockstep:
-                    self.joined = self.in_lockstep = True
-                    rospy.loginfo("simulator: %s in lockstep", self.robot.name)
-                if self.awaiting is not None and stamp >= self.awaiting - 1e-9:
-                    self.awaiting = None
-                self.node.answered.notify_all()
+        if self.node.lockstep and self.node.waits.answered(self.robot.name, stamp):
+            rospy.loginfo("simulator: %s in lockstep", self.robot.name)
 
     def lagging(self, now: float, max_lag: float) -> bool:
         """Whether this robot's command stream is alive but more than max_lag [s] behind simulated time."""
@@ -259,13 +230,9 @@ class RobotIO:
     def publish_drives(self, stamp):
         if self.drive_pub.get_num_connections():  # base_driver with measured drives
             now = stamp.to_sec()
-            if self.node.lockstep:
-                with self.node.answered:
-                    if not self.joined:  # its reader is there: from its first drive states on, not its first answer
-                        self.joined = self.in_lockstep = True
-                        rospy.loginfo("simulator: %s in lockstep", self.robot.name)
-                    if self.in_lockstep:
-                        self.awaiting = now
+            # its reader is there: in lockstep from its first drive states on, not its first answer
+            if self.node.lockstep and self.node.waits.published(self.robot.name, now):
+                rospy.loginfo("simulator: %s in lockstep", self.robot.name)
             self.drive_pub.publish(conversions.state_msg(stamp, self.robot.drive_states(now)))
 
     def close(self):
@@ -277,35 +244,30 @@ class RobotIO:
 
 class SimulatorNode:
     def __init__(self):
-        world_name = str(rospy.get_param("~world", "flat"))
-        world = load_world(resolve_world(world_name))
-        self.gui = bool(rospy.get_param("~gui", False))
-        physics_rate = positive("physics_rate", 240.0)
-        self.real_time_factor = positive("real_time_factor", 1.0, allow_zero=True)
-        clock_rate = positive("clock_rate", 100.0)
-        odometry_rate = positive("odometry_rate", 50.0)
-        drive_state_rate = positive("drive_state_rate", 100.0)
-        self.command_timeout = positive("command_timeout", 0.5)
-        self.max_lag = positive("max_lag", 0.05, allow_zero=True)
-        self.default_tf = bool(rospy.get_param("~publish_tf", True))
-        tyre = positive("tyre_contact_width", 0.01)
-        self.paused = bool(rospy.get_param("~paused", False))
-        diagnostics_rate = positive("diagnostics_rate", 1.0, allow_zero=True)
-        seed = rospy.get_param("~seed", 0)
-        if isinstance(seed, bool) or not isinstance(seed, int):
-            raise ParameterError(f"~seed: {seed!r}: must be a whole number")
-        datum_file = str(rospy.get_param("~datum_file", "") or "")
-        datum = load_datum(datum_file) if datum_file else None
-        self.lockstep = bool(rospy.get_param("~lockstep", False))
-        self.answered = threading.Condition()  # lockstep: a robot answered, or one was let go
+        self.params = params = SimulatorParams.read(lambda name, default: rospy.get_param("~" + name, default))
+        world = load_world(resolve_world(params.world))
+        self.gui = params.gui
+        self.real_time_factor = params.real_time_factor
+        self.command_timeout = params.command_timeout
+        self.max_lag = params.max_lag
+        self.default_tf = params.publish_tf
+        self.paused = params.paused
+        datum = load_datum(params.datum_file) if params.datum_file else None
+        self.lockstep = params.lockstep
+        self.waits = Lockstep()  # lockstep: which robots the world waits for, for which instant
+        self.pacer = Pacer(params.real_time_factor)
         self.client = p.connect(p.GUI if self.gui else p.DIRECT)
-        self.sim = Simulation(self.client, world, physics_rate, tyre, seed=seed, datum=datum)
+        self.sim = Simulation(
+            self.client, world, params.physics_rate, params.tyre_contact_width, seed=params.seed, datum=datum
+        )
         self.lock = threading.RLock()
         self.missing_meshes_said = set()  # mesh URIs warned about: once each, however many robots name them
         self.io = {}
-        self.clock = Every(clock_rate)
-        self.odometry = Every(odometry_rate)
-        self.drives = Every(drive_state_rate)
+        # one grid of simulated time for everything periodic (thorvald_base.rate_grid): the step nearest
+        # each multiple of a period, so 80 Hz at the default 240 Hz physics is every third step
+        self.clock = RateGrid(params.clock_rate, self.sim.dt)
+        self.odometry = RateGrid(params.odometry_rate, self.sim.dt)
+        self.drives = RateGrid(params.drive_state_rate, self.sim.dt)
         # Written in the loop on non-blocking sockets (thorvald_base.publishing): a writer thread per reader
         # cost more than the physics; a blocking write froze the simulation when one reader's link dropped.
         self.clock_pub = NonBlockingPublisher("/clock", Clock)
@@ -316,7 +278,7 @@ class SimulatorNode:
         self.tf_poll_now = threading.Event()  # a spawn: look at /tf's publishers now, not at the next poll
         threading.Thread(target=self.watch_tf, name="tf_watch", daemon=True).start()
         self.diagnostics = NonBlockingPublisher("/diagnostics", DiagnosticArray)
-        self.meter = PerformanceMeter(1.0 / diagnostics_rate) if diagnostics_rate else None
+        self.meter = PerformanceMeter(1.0 / params.diagnostics_rate) if params.diagnostics_rate else None
         rospy.Service("~pause", Empty, self.srv_pause)
         rospy.Service("~unpause", Empty, self.srv_unpause)
         rospy.Service("~reset", Empty, self.srv_reset)
@@ -326,9 +288,9 @@ class SimulatorNode:
         self.publish_clock()
         rospy.loginfo(
             "simulator: world %s (%s), %.0f Hz physics, real-time factor %s%s",
-            world_name,
+            params.world,
             world.source,
-            physics_rate,
+            params.physics_rate,
             self.real_time_factor or "as fast as possible",
             ", paused" if self.paused else "",
         )
@@ -431,6 +393,7 @@ class SimulatorNode:
                 return DeleteRobotResponse(False, str(e))
             self.io.pop(req.model_name).close()
             self.tf_watch.forget(req.model_name)
+            self.waits.forget(req.model_name)
         return DeleteRobotResponse(True, f"deleted {req.model_name}")
 
     def srv_snapshot(self, req):
@@ -457,7 +420,6 @@ class SimulatorNode:
         self.clock_pub.publish(Clock(clock=rospy.Time.from_sec(self.sim.time)))
 
     def spin(self):
-        anchor = None  # (wall, simulated) times from which real-time pacing counts
         while not rospy.is_shutdown():
             if not self.paused:
                 self.wait_for_followers()
@@ -474,40 +436,21 @@ class SimulatorNode:
             if self.meter is not None:
                 self.publish_performance(time.monotonic())
             if paused:
-                anchor = None
+                self.pacer.paused()
                 time.sleep(0.01)
                 continue
-            if self.real_time_factor > 0:
-                wall = time.monotonic()
-                if anchor is None:
-                    anchor = (wall, self.sim.time)
-                ahead = anchor[0] + (self.sim.time - anchor[1]) / self.real_time_factor - wall
-                if ahead > 0:
-                    time.sleep(ahead)
-                elif ahead < -CATCH_UP:
-                    anchor = None  # too slow to keep up: do not race to catch up afterwards
+            self.pacer.stepped(self.sim.time)
 
     def wait_for_answers(self):
         """Lockstep: holds the world until every robot in lockstep answered its last drive states; a
-        robot silent for LOCKSTEP_TIMEOUT of wall time is let go (it joins again with its next command)."""
-        deadline = time.monotonic() + LOCKSTEP_TIMEOUT
-        with self.answered:
-            while not rospy.is_shutdown():
-                waiting = [io for io in list(self.io.values()) if io.in_lockstep and io.awaiting is not None]
-                if not waiting:
-                    return
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    for io in waiting:
-                        io.in_lockstep, io.awaiting = False, None
-                        rospy.logwarn(
-                            "simulator: %s did not answer its drive states for %.1f s: going on without it "
-                            "(it joins lockstep again with its next command)",
-                            io.robot.name,
-                            LOCKSTEP_TIMEOUT,
-                        )
-                    return
-                self.answered.wait(min(left, 0.1))
+        robot silent for the lockstep's timeout of wall time is let go (it joins again with its next command)."""
+        for name in self.waits.wait(rospy.is_shutdown):
+            rospy.logwarn(
+                "simulator: %s did not answer its drive states for %.1f s: going on without it "
+                "(it joins lockstep again with its next command)",
+                name,
+                self.waits.timeout,
+            )
 
     def wait_for_followers(self):
         """Holds the world while a robot's commands lag more than ~max_lag behind (at most MAX_WAIT)."""

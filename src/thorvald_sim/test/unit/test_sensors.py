@@ -20,7 +20,6 @@ from thorvald_sim.sensors import (
     WGS84_A,
     WGS84_E2,
     InstantNoise,
-    Schedule,
     SensorUse,
     beams,
     depth_to_points,
@@ -306,34 +305,6 @@ def test_p3d_reports_its_link_in_the_world(world):
     sim, robot = simulation(world, P3D)
     truth = robot.sensors[0].read(sim.time)
     assert truth.position == pytest.approx((0.0, 0.0, 1.0), abs=0.01)
-
-
-@pytest.mark.parametrize("rate, physics", [(40.0, 240.0), (100.0, 240.0), (30.0, 1000.0), (7.0, 240.0)])
-def test_a_schedule_gives_its_rate_per_simulated_second(rate, physics):
-    schedule = Schedule(rate)
-    dt = 1.0 / physics
-    readings = sum(schedule.due(k * dt, dt) for k in range(int(10 * physics)))
-    assert readings == pytest.approx(10 * rate, abs=1)
-
-
-def test_a_schedule_starts_again_from_when_it_is_read_again():
-    schedule = Schedule(10.0)
-    dt = 1.0 / 240
-    assert schedule.due(0.0, dt)
-    assert not schedule.due(0.05, dt)
-    # nobody read it for 5 s: no burst of the missed readings
-    assert schedule.due(5.0, dt)
-    assert not schedule.due(5.0 + dt, dt)
-
-
-def test_a_schedules_instants_are_its_periods_multiples_whenever_it_began():
-    # 10 Hz at 240 Hz physics: the readings fall on the steps nearest 0.1, 0.2, ... s (steps 24, 48, ...)
-    # whether the sensor was first read at step 5 or at step 17
-    dt = 1.0 / 240
-    for first in (5, 17):
-        schedule = Schedule(10.0)
-        steps = [k for k in range(first, 100) if schedule.due(k * dt, dt)]
-        assert steps == [24, 48, 72, 96]
 
 
 def test_noise_is_seeded():

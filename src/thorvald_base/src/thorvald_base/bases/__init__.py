@@ -22,7 +22,7 @@ name                  handle
 """
 
 import importlib
-from typing import Dict, List
+from typing import Dict, List, Type
 
 from ..errors import ParameterError
 from .handle import BaseHandle, BatteryInfo, ControllerInfo, Frame, IoInfo, MeasuredDrive
@@ -38,20 +38,30 @@ def known_handles() -> List[str]:
     return sorted(BASE_HANDLES)
 
 
-def create_base_handle(config, params, ports=None) -> BaseHandle:
-    """The base handle ``params`` (base_driver's :class:`~thorvald_base.params.DriverParams`) asks
-    for, for this robot; ``ports`` is what the node offers handles that talk over topics
-    (:class:`~thorvald_base.bases.handle.Ports`)."""
+def handle_class_named(name: str) -> Type[BaseHandle]:
+    """The class of the base handle registered as name, imported but not made; KeyError if none is."""
+    module_name, _, class_name = BASE_HANDLES[name].partition(":")
+    return getattr(importlib.import_module(module_name), class_name)
+
+
+def handle_class(params) -> Type[BaseHandle]:
+    """The class of the base handle ``params`` (base_driver's :class:`~thorvald_base.params.DriverParams`)
+    asks for, imported but not made (what it supports, before a bus is opened); ParameterError for an
+    unknown name."""
     name = params.handle
-    target = BASE_HANDLES.get(name)
-    if target is None:
+    if name not in BASE_HANDLES:
         origin = "" if params.base_handle else f" (simple_sim {params.simple_sim})"
         raise ParameterError(
             f"~base_handle: {name!r}{origin}: no such base handle; available: {', '.join(known_handles())}"
         )
-    module_name, _, class_name = target.partition(":")
-    cls = getattr(importlib.import_module(module_name), class_name)
-    return cls.from_params(config, params, ports)
+    return handle_class_named(name)
+
+
+def create_base_handle(config, params, ports=None) -> BaseHandle:
+    """The base handle ``params`` (base_driver's :class:`~thorvald_base.params.DriverParams`) asks
+    for, for this robot; ``ports`` is what the node offers handles that talk over topics
+    (:class:`~thorvald_base.bases.handle.Ports`)."""
+    return handle_class(params).from_params(config, params, ports)
 
 
 __all__ = [
@@ -63,5 +73,7 @@ __all__ = [
     "IoInfo",
     "MeasuredDrive",
     "create_base_handle",
+    "handle_class",
+    "handle_class_named",
     "known_handles",
 ]

@@ -9,7 +9,7 @@ Times are seconds on whichever clock the node uses (ROS time, simulated time in 
 """
 
 from dataclasses import dataclass, replace
-from typing import Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Callable, ClassVar, Dict, List, Optional, Sequence, Tuple
 
 from thorvald_model.config import RobotConfig
 
@@ -134,6 +134,11 @@ class BaseHandle:
       Everything above the handle (drive layer, odometry, joint_states) sees true angles only.
       Homing is the handle's: it drives the controllers' own 0, wherever that stands.
     """
+
+    # Whether base_driver can run in lockstep with a simulator on this handle: the handle then waits
+    # for each instant's measured states (wait_for_states) and answers an instant without a cycle
+    # (answer); see SimulatedJointsBase.
+    supports_lockstep: ClassVar[bool] = False
 
     def __init__(self, config: RobotConfig):
         self.config = config

@@ -44,6 +44,7 @@ SAME_INSTANT = 1e-9  # [s]
 class SimulatedJointsBase(BaseHandle):
     COMMAND_TOPIC = "drive_commands"
     STATE_TOPIC = "drive_states"
+    supports_lockstep = True  # wait_for_states and answer: the simulator's instants, one by one
 
     def __init__(self, config, send: Optional[SendCommands] = None, stale_after: float = 0.5):
         super().__init__(config)

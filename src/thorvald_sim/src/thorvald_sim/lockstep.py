@@ -1,0 +1,101 @@
+"""Lockstep: the world steps past an instant only when every robot in lockstep has answered it.
+
+In lockstep the simulator publishes each robot's drive states of an instant and waits, before its
+next step, until each robot's driver has answered them with a command stamped for that instant
+(or later). A robot is in lockstep from the first drive states it publishes to a reader (so the
+steps before its first answer do not depend on how soon that answer came) or from its first
+command; one that has not answered for ``timeout`` seconds of wall time (its driver died, stopped,
+or reads drive states without being in lockstep) is let go, and the others go on; it joins again
+with its next command. See the simulator node's docstring for the whole contract.
+
+Pure bookkeeping, thread-safe: the node's loop calls :meth:`Lockstep.published` and
+:meth:`Lockstep.wait`; the command callbacks call :meth:`Lockstep.answered`. The wall clock and
+the wait on the condition are the caller's, so tests run it on a clock of their own.
+"""
+
+import threading
+import time
+from dataclasses import dataclass
+from typing import Callable, Dict, List, Optional
+
+TIMEOUT = 2.0  # [s] of wall time a robot in lockstep may leave an instant unanswered before it is let go
+SAME_INSTANT = 1e-9  # [s]: a command stamped this close before an instant answers it (stamps are ns)
+POLL = 0.1  # [s] the longest a wait sleeps before it looks at the clock again
+
+
+@dataclass
+class _Robot:
+    in_lockstep: bool = False  # it answers: joined, and not let go since
+    joined: bool = False  # it was awaited once (a robot let go joins again by a command only)
+    awaiting: Optional[float] = None  # [s] the instant of drive states it has not answered yet
+
+
+class Lockstep:
+    """Which robots the world waits for, and for which instant."""
+
+    def __init__(
+        self,
+        timeout: float = TIMEOUT,
+        clock: Callable[[], float] = time.monotonic,
+        wait: Optional[Callable[[threading.Condition, float], None]] = None,
+    ):
+        self.timeout = timeout
+        self.clock = clock
+        self._wait = wait or (lambda condition, seconds: condition.wait(seconds))
+        self.condition = threading.Condition()
+        self._robots: Dict[str, _Robot] = {}
+
+    def _robot(self, name: str) -> _Robot:
+        return self._robots.setdefault(name, _Robot())
+
+    def published(self, name: str, instant: float) -> bool:
+        """Robot name's drive states of instant [s] went to a reader; whether it joined with them."""
+        with self.condition:
+            robot = self._robot(name)
+            joined = not robot.joined
+            if joined:
+                robot.joined = robot.in_lockstep = True
+            if robot.in_lockstep:
+                robot.awaiting = instant
+            return joined
+
+    def answered(self, name: str, stamp: float) -> bool:
+        """Robot name sent a command stamped for stamp [s]; whether it joined (again) with it."""
+        with self.condition:
+            robot = self._robot(name)
+            joined = not robot.in_lockstep
+            if joined:
+                robot.joined = robot.in_lockstep = True
+            if robot.awaiting is not None and stamp >= robot.awaiting - SAME_INSTANT:
+                robot.awaiting = None
+            self.condition.notify_all()
+            return joined
+
+    def forget(self, name: str) -> None:
+        with self.condition:
+            self._robots.pop(name, None)
+            self.condition.notify_all()
+
+    def waiting(self) -> List[str]:
+        """The robots in lockstep whose last instant is not answered yet."""
+        with self.condition:
+            return [n for n, r in self._robots.items() if r.in_lockstep and r.awaiting is not None]
+
+    def wait(self, stop: Callable[[], bool] = lambda: False) -> List[str]:
+        """Holds until every robot in lockstep answered its last instant, at most ``timeout`` of wall
+        time; returns the robots let go for not answering (each joins again with its next command)."""
+        deadline = self.clock() + self.timeout
+        with self.condition:
+            while not stop():
+                waiting = [r for r in self._robots.values() if r.in_lockstep and r.awaiting is not None]
+                if not waiting:
+                    return []
+                left = deadline - self.clock()
+                if left <= 0.0:
+                    let_go = [n for n, r in self._robots.items() if r.in_lockstep and r.awaiting is not None]
+                    for name in let_go:
+                        robot = self._robots[name]
+                        robot.in_lockstep, robot.awaiting = False, None
+                    return let_go
+                self._wait(self.condition, min(left, POLL))
+        return []

@@ -1,0 +1,77 @@
+"""The simulator node's private parameters, read once into one frozen value.
+
+:meth:`SimulatorParams.read` takes a getter (``name, default -> value``: the node passes
+``rospy.get_param("~" + name, default)``), checks every parameter against its rule and raises
+:class:`~thorvald_sim.errors.ParameterError` naming the parameter, the value and the rule. The node
+reads nothing else from the parameter server; everything after the start works on this value.
+The defaults and what each parameter means: the simulator node's docstring.
+
+Pure: no rospy.
+"""
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from .errors import ParameterError
+
+Getter = Callable[[str, Any], Any]
+
+
+@dataclass(frozen=True)
+class SimulatorParams:
+    world: str = "flat"
+    gui: bool = False
+    physics_rate: float = 240.0  # [Hz]
+    real_time_factor: float = 1.0  # 0: as fast as the machine can
+    clock_rate: float = 80.0  # [Hz] of simulated time: every third step at 240 Hz physics
+    odometry_rate: float = 50.0  # [Hz]
+    drive_state_rate: float = 80.0  # [Hz]
+    command_timeout: float = 0.5  # [s]
+    max_lag: float = 0.05  # [s]; 0: never wait for a lagging robot
+    publish_tf: bool = True
+    tyre_contact_width: float = 0.01  # [m]
+    paused: bool = False
+    diagnostics_rate: float = 1.0  # [Hz] of wall time; 0: none
+    seed: int = 0
+    datum_file: str = ""
+    lockstep: bool = False
+
+    @classmethod
+    def read(cls, get: Getter) -> "SimulatorParams":
+        """Every parameter through get (name, default), checked; ParameterError at the first broken one."""
+        d = cls()
+        seed = get("seed", d.seed)
+        if isinstance(seed, bool) or not isinstance(seed, int):
+            raise ParameterError(f"~seed: {seed!r}: must be a whole number")
+        return cls(
+            world=str(get("world", d.world)),
+            gui=bool(get("gui", d.gui)),
+            physics_rate=_number(get, "physics_rate", d.physics_rate),
+            real_time_factor=_number(get, "real_time_factor", d.real_time_factor, allow_zero=True),
+            clock_rate=_number(get, "clock_rate", d.clock_rate),
+            odometry_rate=_number(get, "odometry_rate", d.odometry_rate),
+            drive_state_rate=_number(get, "drive_state_rate", d.drive_state_rate),
+            command_timeout=_number(get, "command_timeout", d.command_timeout),
+            max_lag=_number(get, "max_lag", d.max_lag, allow_zero=True),
+            publish_tf=bool(get("publish_tf", d.publish_tf)),
+            tyre_contact_width=_number(get, "tyre_contact_width", d.tyre_contact_width),
+            paused=bool(get("paused", d.paused)),
+            diagnostics_rate=_number(get, "diagnostics_rate", d.diagnostics_rate, allow_zero=True),
+            seed=seed,
+            datum_file=str(get("datum_file", d.datum_file) or ""),
+            lockstep=bool(get("lockstep", d.lockstep)),
+        )
+
+
+def _number(get: Getter, name: str, default: float, allow_zero: bool = False) -> float:
+    value = get(name, default)
+    if isinstance(value, bool):
+        raise ParameterError(f"~{name}: {value!r}: must be a number")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"~{name}: {value!r}: must be a number") from None
+    if not math.isfinite(number) or number < 0 or (number == 0 and not allow_zero):
+        raise ParameterError(f"~{name}: {value!r}: must be {'>= 0' if allow_zero else '> 0'}")
+    return number

@@ -1,0 +1,179 @@
+"""The simulation loop's pure parts with a clock of the test's own: pacing, lockstep, parameters."""
+
+import threading
+
+import pytest
+
+from thorvald_sim.errors import ParameterError, ThorvaldSimError
+from thorvald_sim.lockstep import Lockstep
+from thorvald_sim.pacing import Pacer
+from thorvald_sim.params import SimulatorParams
+
+
+class FakeClock:
+    """Wall time [s] that moves only when told (or when something sleeps on it)."""
+
+    def __init__(self):
+        self.now = 100.0
+        self.slept = []
+
+    def __call__(self):
+        return self.now
+
+    def sleep(self, seconds):
+        self.slept.append(seconds)
+        self.now += seconds
+
+
+# ---- pacing --------------------------------------------------------------------------------------
+def test_pacing_keeps_the_real_time_factor():
+    clock = FakeClock()
+    pacer = Pacer(2.0, clock=clock, sleep=clock.sleep)
+    dt = 1.0 / 240
+    for k in range(1, 481):  # 2 simulated seconds, each step costing 1 ms of wall time
+        clock.now += 0.001
+        pacer.stepped(k * dt)
+    # at 2 x real time, 2 simulated seconds take 1 wall second (the first step is the anchor)
+    assert clock.now - 100.0 == pytest.approx(1.0 - 1.0 / 480 + 0.001, abs=1e-9)
+
+
+def test_a_stall_is_followed_by_no_burst():
+    clock = FakeClock()
+    pacer = Pacer(1.0, clock=clock, sleep=clock.sleep)
+    dt = 0.01
+    pacer.stepped(dt)
+    for k in range(2, 11):
+        pacer.stepped(k * dt)  # on pace: each step waits 10 ms
+    assert clock.slept[-1] == pytest.approx(0.01)
+    clock.now += 3.0  # a 3 s stall (a busy machine)
+    pacer.stepped(11 * dt)  # behind by 2.99 s: a new anchor, not a race
+    assert pacer.restarts == 1
+    waits = []
+    for k in range(12, 20):
+        before = len(clock.slept)
+        pacer.stepped(k * dt)
+        waits.append(clock.slept[-1] if len(clock.slept) > before else 0.0)
+    # the step after the stall takes the new anchor (no wait), then the pace of real time again: no
+    # steps at full speed to make up the 3 s
+    assert waits == pytest.approx([0.0] + [0.01] * 7)
+
+
+def test_a_small_lag_is_made_up_but_not_a_large_one():
+    clock = FakeClock()
+    pacer = Pacer(1.0, catch_up=0.05, clock=clock, sleep=clock.sleep)
+    pacer.stepped(0.0)
+    clock.now += 0.04  # 40 ms late at the next step: within catch_up, the pace holds its anchor
+    pacer.stepped(0.0 + 0.001)
+    assert pacer.restarts == 0 and pacer.anchor is not None
+
+
+def test_as_fast_as_possible_never_waits_and_a_pause_drops_the_anchor():
+    clock = FakeClock()
+    fast = Pacer(0.0, clock=clock, sleep=clock.sleep)
+    assert all(fast.stepped(k * 0.01) == 0.0 for k in range(100)) and clock.slept == []
+    paced = Pacer(1.0, clock=clock, sleep=clock.sleep)
+    paced.stepped(1.0)
+    paced.paused()
+    assert paced.anchor is None
+    clock.now += 60.0  # paused a minute: no burst after it either
+    assert paced.stepped(1.01) == 0.0 and paced.restarts == 0
+
+
+@pytest.mark.parametrize("factor", [-1.0, float("nan"), float("inf")])
+def test_a_bad_factor_is_refused(factor):
+    with pytest.raises(ValueError):
+        Pacer(factor)
+
+
+# ---- lockstep ------------------------------------------------------------------------------------
+def lockstep(timeout=2.0):
+    """A Lockstep whose waits advance the test's clock instead of the wall's."""
+    clock = FakeClock()
+
+    def wait(condition, seconds):
+        clock.now += seconds
+
+    return Lockstep(timeout, clock=clock, wait=wait), clock
+
+
+def test_each_robot_answers_an_instant_before_the_next():
+    steps, clock = lockstep()
+    assert steps.published("r1", 0.0125) and steps.published("r2", 0.0125)  # both join with their first states
+    assert steps.waiting() == ["r1", "r2"]
+    steps.answered("r1", 0.0125)
+    assert steps.waiting() == ["r2"]
+    steps.answered("r2", 0.0125)
+    assert steps.wait() == [] and clock.now == 100.0  # nothing to wait for: no time passes
+
+
+def test_an_older_command_does_not_answer_a_newer_instant():
+    steps, _ = lockstep()
+    steps.published("r1", 0.05)
+    steps.answered("r1", 0.0375)
+    assert steps.waiting() == ["r1"]
+    steps.answered("r1", 0.05 - 1e-10)  # a stamp's nanoseconds: the same instant
+    assert steps.waiting() == []
+
+
+def test_a_robot_that_never_answers_is_released_after_its_timeout_and_the_others_go_on():
+    steps, clock = lockstep(timeout=2.0)
+    steps.published("silent", 0.1)
+    steps.published("r2", 0.1)
+    steps.answered("r2", 0.1)
+    assert steps.wait() == ["silent"]
+    assert clock.now - 100.0 == pytest.approx(2.0)
+    # let go: the world no longer waits for it, while r2 is still awaited each instant
+    steps.published("silent", 0.2)
+    steps.published("r2", 0.2)
+    assert steps.waiting() == ["r2"]
+    # its next command brings it back
+    assert steps.answered("silent", 0.2)
+    steps.published("silent", 0.3)
+    assert "silent" in steps.waiting()
+
+
+def test_a_wait_ends_when_the_answer_comes_from_another_thread():
+    steps = Lockstep(timeout=30.0)
+    steps.published("r1", 1.0)
+    threading.Timer(0.05, steps.answered, args=("r1", 1.0)).start()
+    assert steps.wait() == []
+
+
+def test_a_forgotten_robot_is_not_waited_for():
+    steps, _ = lockstep()
+    steps.published("deleted", 1.0)
+    steps.forget("deleted")
+    assert steps.waiting() == [] and steps.wait() == []
+
+
+# ---- parameters ----------------------------------------------------------------------------------
+def test_parameters_are_read_once_with_their_defaults():
+    asked = []
+
+    def get(name, default):
+        asked.append(name)
+        return {"real_time_factor": 0, "seed": 7, "world": "slope"}.get(name, default)
+
+    params = SimulatorParams.read(get)
+    assert params == SimulatorParams(real_time_factor=0.0, seed=7, world="slope")
+    assert params.clock_rate == 80.0 and params.publish_tf is True
+    assert len(asked) == len(set(asked)) == 16  # every parameter, each once
+
+
+@pytest.mark.parametrize(
+    "name, value, rule",
+    [
+        ("physics_rate", 0, "must be > 0"),
+        ("physics_rate", "fast", "must be a number"),
+        ("physics_rate", True, "must be a number"),
+        ("clock_rate", float("nan"), "must be > 0"),
+        ("real_time_factor", -1, "must be >= 0"),
+        ("seed", 1.5, "must be a whole number"),
+        ("seed", True, "must be a whole number"),
+    ],
+)
+def test_a_bad_parameter_is_refused_with_its_name_value_and_rule(name, value, rule):
+    with pytest.raises(ParameterError) as e:
+        SimulatorParams.read(lambda n, d: value if n == name else d)
+    assert str(e.value).startswith(f"~{name}: {value!r}: {rule}")
+    assert isinstance(e.value, ThorvaldSimError)
