@@ -1,6 +1,8 @@
 """Builds a world (:class:`thorvald_sim.world.WorldConfig`) in a pybullet client.
 
-The caller passes in the client id; nothing here connects to pybullet or talks to ROS. Every body
+The caller passes in the client id; nothing here connects to pybullet or talks to ROS. Each kind of
+world element has its builder here (``build_patch``, ...), which the registry of element kinds
+names (:mod:`thorvald_sim.world.registry`); :func:`build_scene` iterates the registry. Every body
 but an object with a mass is static (mass 0), so the world costs the solver nothing but its contacts:
 
 - the ground: a plane at z = 0, or the height field's grid in its place; in a world with soft
@@ -58,7 +60,7 @@ import math
 import os
 import tempfile
 from dataclasses import dataclass
-from typing import Dict, Iterator, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Tuple
 
 import numpy as np
 import pybullet as p
@@ -71,6 +73,7 @@ from .world import (
     RGBA_ICE,
     SOFT_DEPTH,
     TABLE_DEPTH,
+    ElementKind,
     HeightField,
     Patch,
     Polytunnel,
@@ -82,6 +85,7 @@ from .world import (
     Wall,
     WorldConfig,
     WorldObject,
+    element_kinds,
     ground_pieces,
     plant_positions,
 )
@@ -140,39 +144,76 @@ class Scene:
 
 
 def build_scene(client: int, world: WorldConfig) -> Scene:
-    """Sets gravity and adds every body of the world to the pybullet client; returns their ids."""
+    """Sets gravity and adds every body of the world to the pybullet client; returns their ids.
+
+    The ground plane first (unless a height field takes its place), then each element of every
+    kind of the registry (:func:`thorvald_sim.world.element_kinds`), in its order, by the kind's
+    builder.
+    """
     p.setGravity(0, 0, -world.gravity, physicsClientId=client)
     bodies: Dict[str, int] = {}
     if world.height_field is None and world.soft_patches:
         _add(bodies, "ground", _ground_with_holes(client, world))
     elif world.height_field is None:
         bodies["ground"] = _ground(client, world.ground, world.ground_rgba)
-    else:
-        bodies["ground"] = _height_field(client, world.height_field, world.ground, world.ground_rgba)
-    for patch in world.patches:
-        bodies[f"patches.{patch.name}"] = _patch(client, patch, holes=bool(world.soft_patches))
-    for slope in world.slopes:
-        bodies[f"slopes.{slope.name}"] = _slope(client, slope)
-    for rail in world.rails:
-        left, right = _rail(client, rail)
-        bodies[f"rails.{rail.name}.left"] = left
-        bodies[f"rails.{rail.name}.right"] = right
-    for thing in world.objects:
-        bodies[f"objects.{thing.name}"] = _object(client, thing)
-    for rows in world.rows:
-        for k, parts in enumerate(_rows(world, rows)):
-            ids = [body for mesh in parts for body in _mesh_bodies(client, mesh, rows.rgba, rows.surface)]
-            _add(bodies, f"rows.{rows.name}.{k}", ids)
-    for tunnel in world.polytunnels:
-        _polytunnel(client, tunnel, bodies)
-    for wall in world.walls:
-        bodies[f"walls.{wall.name}"] = _wall(client, wall)
+    for kind in element_kinds():
+        build = builder_of(kind)
+        for element in world.elements(kind.section):
+            build(client, world, element, kind.body_name(element), bodies)
     return Scene(world, bodies)
+
+
+def builder_of(kind: ElementKind) -> Callable[[int, WorldConfig, Any, str, Dict[str, int]], None]:
+    """The kind's scene builder: its function, or the function of this module it names."""
+    if callable(kind.builder):
+        return kind.builder
+    found = globals().get(kind.builder)
+    if not callable(found):
+        raise LookupError(f"element kind {kind.section!r}: thorvald_sim.scene has no builder {kind.builder!r}")
+    return found
 
 
 def _add(bodies: Dict[str, int], name: str, ids: Sequence[int]) -> None:
     for k, body in enumerate(ids):
         bodies[name if k == 0 else f"{name}.part{k}"] = body
+
+
+# ---------------------------------------------------------------------------------------------
+# The element kinds' builders: (client, world, element, name, bodies), each adding the element's
+# bodies under its name (the registry's entries name them)
+# ---------------------------------------------------------------------------------------------
+def build_height_field(client: int, world: WorldConfig, field: HeightField, name: str, bodies: Dict[str, int]) -> None:
+    bodies[name] = _height_field(client, field, world.ground, world.ground_rgba)
+
+
+def build_patch(client: int, world: WorldConfig, patch: Patch, name: str, bodies: Dict[str, int]) -> None:
+    bodies[name] = _patch(client, patch, holes=bool(world.soft_patches))
+
+
+def build_slope(client: int, world: WorldConfig, slope: Slope, name: str, bodies: Dict[str, int]) -> None:
+    bodies[name] = _slope(client, slope)
+
+
+def build_rail(client: int, world: WorldConfig, rail: Rail, name: str, bodies: Dict[str, int]) -> None:
+    bodies[f"{name}.left"], bodies[f"{name}.right"] = _rail(client, rail)
+
+
+def build_object(client: int, world: WorldConfig, thing: WorldObject, name: str, bodies: Dict[str, int]) -> None:
+    bodies[name] = _object(client, thing)
+
+
+def build_rows(client: int, world: WorldConfig, rows: Rows, name: str, bodies: Dict[str, int]) -> None:
+    for k, parts in enumerate(_rows(world, rows)):
+        ids = [body for mesh in parts for body in _mesh_bodies(client, mesh, rows.rgba, rows.surface)]
+        _add(bodies, f"{name}.{k}", ids)
+
+
+def build_polytunnel(client: int, world: WorldConfig, tunnel: Polytunnel, name: str, bodies: Dict[str, int]) -> None:
+    _polytunnel(client, tunnel, name, bodies)
+
+
+def build_wall(client: int, world: WorldConfig, wall: Wall, name: str, bodies: Dict[str, int]) -> None:
+    bodies[name] = _wall(client, wall)
 
 
 def _ground(client: int, surface: Surface, rgba: Rgba) -> int:
@@ -665,7 +706,7 @@ def _rows(world: WorldConfig, rows: Rows) -> List[List[_Mesh]]:
 # ---------------------------------------------------------------------------------------------
 # Polytunnels
 # ---------------------------------------------------------------------------------------------
-def _polytunnel(client: int, t: Polytunnel, bodies: Dict[str, int]) -> None:
+def _polytunnel(client: int, t: Polytunnel, name: str, bodies: Dict[str, int]) -> None:
     c, s = math.cos(t.yaw), math.sin(t.yaw)
     along, across, up = np.array((c, s, 0.0)), np.array((-s, c, 0.0)), np.array((0.0, 0.0, 1.0))
     origin = np.array((t.x, t.y, t.z))
@@ -675,7 +716,6 @@ def _polytunnel(client: int, t: Polytunnel, bodies: Dict[str, int]) -> None:
         u, v, z = np.broadcast_arrays(*(np.asarray(q, dtype=float) for q in (u, v, z)))
         return origin + u[..., None] * along + v[..., None] * across + z[..., None] * up
 
-    name = f"polytunnels.{t.name}"
     # The legs of each side and the roof (arches and poles, all from leg_height up) are bodies of their
     # own: bullet pairs a robot with a body whose bounding box it enters, and a robot in the tunnel
     # enters none of these three then (one body of the whole frame cost a fifth of the step).

@@ -1,0 +1,217 @@
+"""Loading a world file: every element kind of the registry read, checked against the budgets and
+made, and the shipped worlds found by name.
+
+Every problem is collected with its dotted key path, value and rule, and raised together in one
+:class:`~thorvald_model.errors.ConfigError`; nothing is made that a broken budget counts.
+"""
+
+import glob
+import os
+from dataclasses import fields
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
+
+from thorvald_model.errors import MISSING, ConfigError, Problem
+from thorvald_model.resources import package_folder
+from thorvald_model.schema import check_top_level, parse_entry, parse_scalar, parse_section, read_yaml_file
+
+from .budgets import budget_problems
+from .geometry import _ground_height
+from .keys import (
+    DESCRIPTION_KEY,
+    GRAVITY_KEY,
+    GROUND_DEFAULTS,
+    GROUND_KEYS,
+    RGBA_KEY,
+    RGBA_RULE,
+    WHAT,
+    _kind_colour,
+    _surface_of,
+)
+from .kind import Context, ElementKind, Entry
+from .registry import element_kinds, top_level_keys
+from .values import RGBA_TARMAC, Rgba, Surface, WorldConfig
+
+# The package folder when this module runs from the source tree (or the devel space, which relays
+# to it); in an install space the worlds are under share/thorvald_sim instead.
+PACKAGE_DIR = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+
+
+def load_world(path: str) -> WorldConfig:
+    """Loads and validates a world file; raises ConfigError naming every problem.
+
+    A file that cannot be read at all (missing, a directory, not text, not YAML) raises a
+    ConfigError with one problem at the top level, which formats as one line. Relative paths in
+    the file (meshes, images) are from the file's folder.
+    """
+    return parse_world(read_yaml_file(path, WHAT), path, os.path.dirname(os.path.abspath(path)))
+
+
+def parse_world(data: Any, source: str = "<world>", base_dir: Optional[str] = None) -> WorldConfig:
+    """Validates an already parsed world (a YAML document or a ROS parameter tree).
+
+    base_dir: the folder relative paths (meshes, images) are taken from; default the current one.
+    """
+    base_dir = os.path.abspath(base_dir or os.getcwd())
+    problems: List[Problem] = []
+    kinds = element_kinds()
+    data = check_top_level(data, top_level_keys(), problems, source=source, what=WHAT)
+
+    # The two scalar keys go through parse_entry as a one-key entry each, so they get the same
+    # coercion and rules as every other key; their paths are the bare key names.
+    gravity = parse_scalar(data, GRAVITY_KEY, problems)
+    description = parse_scalar(data, DESCRIPTION_KEY, problems)
+    ground, ground_colour = _ground(data, problems)
+
+    # The kinds the others stand on (or beside) are made as they are read; the budgets are checked
+    # before anything that grows with them is made. A world over them is refused anyway: its
+    # objects, tunnels and walls take the plane's height, without a search.
+    context = Context(data, base_dir, problems, ground)
+    entries: Dict[str, List[Entry]] = {}
+    for kind in kinds:
+        entries[kind.section] = _entries(kind, data, problems)
+        if not kind.on_ground:
+            _make(kind, entries[kind.section], context)
+    context.over_budget = budget_problems(kinds, entries, problems)
+    if not context.over_budget:
+        height_field, slopes, patches = context.single("height_field"), context.made["slopes"], context.made["patches"]
+        context.ground_at = lambda px, py: _ground_height(height_field, slopes, patches, px, py)
+    for kind in kinds:
+        if kind.on_ground:
+            _make(kind, entries[kind.section], context)
+
+    if problems:
+        raise ConfigError(source, problems, WHAT)
+    base = dict(source=source, gravity=gravity, description=description, ground=ground, ground_rgba=ground_colour)
+    return _world(kinds, context, base)
+
+
+def _ground(data: Mapping, problems: List[Problem]) -> Tuple[Surface, Rgba]:
+    """The ground's surface and colour. A missing ground, or an empty ``ground:`` (YAML null),
+    means every default, as for sections."""
+    raw_ground = data.get("ground")
+    raw_ground = {} if raw_ground is None else raw_ground
+    raw_ground, ground_colour = _take_colour(raw_ground, "ground", None, problems)
+    ground_values = parse_entry(raw_ground, "ground", GROUND_KEYS, problems)
+    if ground_values is None:
+        ground_values = {k.name: k.default for k in GROUND_KEYS}
+    ground = _surface_of(ground_values, GROUND_DEFAULTS)
+    return ground, ground_colour or _kind_colour(ground) or RGBA_TARMAC
+
+
+def _entries(kind: ElementKind, data: Mapping, problems: List[Problem]) -> List[Entry]:
+    """The kind's entries in the file, their keys checked (in index order; those without a required
+    key left out, their problems reported)."""
+    section = data.get(kind.section)
+    coloured = RGBA_KEY in kind.keys
+    if kind.single:
+        if section is None:
+            return []
+        raw, colour = _take_colour(section, kind.section, None, problems) if coloured else (section, None)
+        values = parse_entry(raw, kind.section, kind.keys, problems)
+        if values is None:
+            return []
+        if coloured:
+            values["rgba"] = colour
+        return [Entry(kind.section, 0, values, section, kind.section)]
+    raw, colours = _take_colours(section, kind.section, problems) if coloured else (section, {})
+    found = []
+    for name, index, values in parse_section(raw, kind.section, kind.prefix, kind.keys, problems):
+        if coloured:
+            values["rgba"] = colours.get(name)
+        found.append(Entry(name, index, values, _raw_entry(section, name), f"{kind.section}.{name}"))
+    return found
+
+
+def _make(kind: ElementKind, entries: Sequence[Entry], context: Context) -> None:
+    """The kind's elements into context.made (an entry whose maker gives None left out), then its check."""
+    made = tuple(element for element in (kind.make(entry, context) for entry in entries) if element is not None)
+    context.made[kind.section] = made
+    if kind.check is not None:
+        kind.check(made, context)
+
+
+def _world(kinds: Sequence[ElementKind], context: Context, base: Mapping[str, Any]) -> WorldConfig:
+    """The world of base (its fields that are no kind's) and the made elements: each kind's in its
+    field of WorldConfig (a single mapping's value or None), or else in ``extra``."""
+    names = {f.name for f in fields(WorldConfig)}
+    own: Dict[str, Any] = {}
+    extra: List[Tuple[str, Any]] = []
+    for kind in kinds:
+        made = context.single(kind.section) if kind.single else context.made[kind.section]
+        if kind.section in names:
+            own[kind.section] = made
+        else:
+            extra.append((kind.section, made))
+    return WorldConfig(**base, **own, extra=tuple(extra))
+
+
+# ---------------------------------------------------------------------------------------------
+# Colours (rgba is a list, which the schema's keys do not take: checked here, and "" in the entry)
+# ---------------------------------------------------------------------------------------------
+def _raw_entry(section: Any, name: str) -> Mapping:
+    entry = section.get(name) if isinstance(section, Mapping) else None
+    return entry if isinstance(entry, Mapping) else {}
+
+
+def _colour(value: Any) -> Optional[Rgba]:
+    """The colour a list of 3 or 4 numbers in [0, 1] gives (alpha 1 if left out); None if it is not one."""
+    if not isinstance(value, (list, tuple)) or len(value) not in (3, 4):
+        return None
+    numbers = []
+    for v in value:
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v <= 1.0:
+            return None
+        numbers.append(float(v))
+    return (*numbers, 1.0) if len(numbers) == 3 else tuple(numbers)
+
+
+def _take_colour(entry: Any, path: str, default: Rgba, problems: List[Problem]) -> Tuple[Any, Rgba]:
+    """The entry with its rgba, checked here, replaced by "" for parse_entry, and the colour."""
+    if not isinstance(entry, Mapping) or "rgba" not in entry:
+        return entry, default
+    colour = _colour(entry["rgba"])
+    if colour is None:
+        problems.append(Problem(f"{path}.rgba", entry["rgba"], RGBA_RULE))
+    return {**entry, "rgba": ""}, colour or default
+
+
+def _take_colours(section: Any, key: str, problems: List[Problem]) -> Tuple[Any, Dict[str, Optional[Rgba]]]:
+    """The section with each entry's rgba taken out (as :func:`_take_colour`), and the colours by entry."""
+    if not isinstance(section, Mapping):
+        return section, {}
+    clean, colours = {}, {}
+    for name, entry in section.items():
+        clean[name], colour = _take_colour(entry, f"{key}.{name}", None, problems)
+        colours[str(name)] = colour
+    return clean, colours
+
+
+# ---------------------------------------------------------------------------------------------
+# Shipped worlds
+# ---------------------------------------------------------------------------------------------
+def worlds_dir() -> str:
+    """The shipped worlds' folder, in the devel or install space (or the source tree)."""
+    return os.path.join(package_folder("thorvald_sim", PACKAGE_DIR), "worlds")
+
+
+def shipped_worlds() -> List[str]:
+    """Names of the shipped worlds (``flat``, ...), sorted."""
+    return sorted(os.path.splitext(os.path.basename(f))[0] for f in glob.glob(os.path.join(worlds_dir(), "*.yaml")))
+
+
+def resolve_world(name_or_path: str) -> str:
+    """The file of a world given by name (a shipped world) or by path.
+
+    A shipped world's name wins over a file of that name in the current folder. Anything that looks
+    like a path (has a folder separator or a YAML extension) or names an existing file is returned
+    as it is, so that a missing file is reported by :func:`load_world` with the reason; a bare name
+    that is neither raises a ConfigError of one line listing the shipped worlds.
+    """
+    names = shipped_worlds()
+    if name_or_path in names:
+        return os.path.join(worlds_dir(), name_or_path + ".yaml")
+    looks_like_path = os.sep in name_or_path or name_or_path.endswith((".yaml", ".yml"))
+    if looks_like_path or os.path.exists(name_or_path):
+        return name_or_path
+    rule = "no such world: give a file or one of " + ", ".join(names)
+    raise ConfigError(name_or_path, [Problem("", MISSING, rule)], WHAT)
