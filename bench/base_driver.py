@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """base_driver and twist_mux benchmark: latency, CPU share and the highest loop rate held.
 
-    python3 bench/base_driver.py [--port 11399] [--samples 250] [--window 10]
+    python3 bench/base_driver.py [--port PORT] [--samples 250] [--window 10]
 
-Starts its own roscore on a free port (11399 or the next free one) and its own nodes, measures, and
-stops every process it started, also on an error or Ctrl-C. Needs the workspace sourced.
+Starts its own roscore (on a free port unless --port says) and its own nodes through the tests'
+harness (thorvald_testing), measures, and stops every process it started, also on an error or
+Ctrl-C. Needs the workspace sourced.
 
 1. Latency from a cmd_vel message to the joint_commands that carries it, 4-drive standard robot at
    50 Hz: each command has its own vx (0.2 m/s + 2 mm/s per message, straight ahead, so every wheel's
@@ -21,17 +22,16 @@ stops every process it started, also on an error or Ctrl-C. Needs the workspace 
 """
 
 import argparse
+import contextlib
 import os
 import random
 import signal
-import socket
 import statistics
-import subprocess
 import sys
+import tempfile
 import threading
 import time
 
-import rosgraph
 import rospkg
 import rospy
 import yaml
@@ -41,82 +41,33 @@ from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 
 from thorvald_msgs.msg import BaseState
+from thorvald_testing import Master, Processes, cpu_seconds, poll
 
 STD = "thorvald_ii_4wd4ws_std"
 NINE = "thorvald_ii_9wd9ws"
 RATES = (100, 200, 400, 800)  # [Hz]
 HELD = 0.95  # achieved / requested rate that counts as held
-CLK_TCK = os.sysconf("SC_CLK_TCK")
 
 
-# ---- processes ---------------------------------------------------------------------------------
-class Processes:
-    """Every process this script starts, each in its own session, so all its children stop with it."""
-
-    def __init__(self):
-        self.procs = []
-
-    def start(self, args, log):
-        p = subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
-        self.procs.append(p)
-        return p
-
-    def stop(self, p, timeout=10.0):
-        if p.poll() is None:
-            for sig, wait in ((signal.SIGINT, timeout), (signal.SIGTERM, 3.0), (signal.SIGKILL, 3.0)):
-                try:
-                    os.killpg(p.pid, sig)
-                except ProcessLookupError:
-                    break
-                try:
-                    p.wait(wait)
-                    break
-                except subprocess.TimeoutExpired:
-                    continue
-        if p in self.procs:
-            self.procs.remove(p)
-
-    def stop_all(self):
-        for p in reversed(list(self.procs)):
-            self.stop(p)
-
-
-def free_port(first):
-    for port in range(first, first + 100):
-        with socket.socket() as s:
-            try:
-                s.bind(("localhost", port))
-                return port
-            except OSError:
-                continue
-    raise RuntimeError(f"no free port in {first}..{first + 99}")
-
-
-def cpu_seconds(pid, missing=None):
-    """utime + stime [s] of a process (/proc/<pid>/stat fields 14 and 15); missing if it has gone
-    (None: raise)."""
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            fields = f.read().rsplit(")", 1)[1].split()
-    except OSError:
-        if missing is None:
-            raise
-        return missing
-    return (int(fields[11]) + int(fields[12])) / CLK_TCK
-
-
-def start_master(procs, log, port, node_name, master_only=False):
-    """roscore (or a bare rosmaster) on port, and this process as node_name on it; the master's process."""
-    os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
-    command = ["rosmaster", "--core", "-p", str(port)] if master_only else ["roscore", "-p", str(port)]
-    proc = procs.start(command, log)
-    deadline = time.time() + 60
-    while not rosgraph.Master("/bench").is_online():
-        if time.time() > deadline:
-            raise RuntimeError(f"{command[0]} did not come up")
-        time.sleep(0.2)
-    rospy.init_node(node_name, disable_signals=True)
-    return proc
+# ---- the session: the benchmarks' one way to run ROS (thorvald_testing, as the tests) ----------
+@contextlib.contextmanager
+def ros_session(name, core_only=False, port=None):
+    """(master, processes): a ROS master of the benchmark's own (thorvald_testing.Master, ROS_HOME in
+    a temporary folder; core_only: a bare rosmaster, no rosout), this process a node called name on
+    it, and a thorvald_testing.Processes for what the benchmark starts. Everything is stopped on the
+    way out, also on an error, Ctrl-C or SIGTERM (which main turns into SystemExit)."""
+    with tempfile.TemporaryDirectory(prefix=f"{name}_") as home:
+        master = Master(home, core_only=core_only, port=port)
+        procs = Processes()
+        try:
+            os.environ.update(master.env)  # rospy and every process started from here use the master
+            rospy.init_node(name, disable_signals=True)
+            yield master, procs
+        finally:
+            with contextlib.suppress(Exception):
+                rospy.signal_shutdown("benchmark done")
+            procs.stop_all()
+            master.stop()
 
 
 def percentile(values, q):
@@ -129,9 +80,8 @@ def percentile(values, q):
 
 # ---- the benchmark -----------------------------------------------------------------------------
 class Bench:
-    def __init__(self, procs, log):
+    def __init__(self, procs):
         self.procs = procs
-        self.log = log
         self.config_dir = os.path.join(rospkg.RosPack().get_path("thorvald_model"), "config")
         self.mux_config = os.path.join(rospkg.RosPack().get_path("thorvald_bringup"), "config", "twist_mux.yaml")
 
@@ -155,18 +105,13 @@ class Bench:
                 f"__ns:=/{ns}",
                 "cmd_vel:=twist_mux/cmd_vel",
                 "joint_states:=base_driver/joint_states",
-            ],
-            self.log,
+            ]
         )
         rospy.wait_for_message(f"/{ns}/odometry/base_raw", Odometry, timeout=60)
         return p
 
     def wait_subscribed(self, pub, timeout=30.0):
-        deadline = time.time() + timeout
-        while not pub.get_num_connections():
-            if time.time() > deadline:
-                raise RuntimeError(f"nobody subscribed to {pub.resolved_name}")
-            time.sleep(0.05)
+        poll(pub.get_num_connections, timeout, f"a subscriber to {pub.resolved_name}")
         time.sleep(0.5)  # let the connection settle before timing it
 
     def stamped_latency(self, pub_topic, sub_topic, sub_type, *, speed_of, samples, interval):
@@ -225,8 +170,7 @@ class Bench:
                 "__name:=twist_mux",
                 "__ns:=/mux",
                 "cmd_vel_out:=twist_mux/cmd_vel",
-            ],
-            self.log,
+            ]
         )
         try:
             return self.stamped_latency(
@@ -296,21 +240,20 @@ class Bench:
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--port", type=int, default=11399, help="first port to try for the roscore")
+    parser.add_argument("--port", type=int, default=None, help="the roscore's port (default: a free one)")
     parser.add_argument("--samples", type=int, default=250, help="commands per latency measurement")
     parser.add_argument("--window", type=float, default=10.0, help="CPU measurement window [s]")
     args = parser.parse_args()
 
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))  # through the finally below: stop every process
-    port = free_port(args.port)
-    procs = Processes()
-    log = open(os.devnull, "w")
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))  # through ros_session's exit: stop every process
     load_before = os.getloadavg()[0]
     rows = []
-    try:
-        start_master(procs, log, port, "bench_base_driver")
-        bench = Bench(procs, log)
-        print(f"roscore on port {port}; {os.cpu_count()} cores, load average {load_before:.2f} at start", flush=True)
+    with ros_session("bench_base_driver", port=args.port) as (master, procs):
+        bench = Bench(procs)
+        print(
+            f"roscore on port {master.port}; {os.cpu_count()} cores, load average {load_before:.2f} at start",
+            flush=True,
+        )
 
         lat, lost = bench.command_latency(args.samples)
         rows.append(
@@ -341,13 +284,6 @@ def main():
         )
         rows.append(("twist_mux nav_vel -> twist_mux/cmd_vel, p99", "", f"{1e3 * percentile(lat, 0.99):.2f} ms", ""))
         print(f"  mux: {len(lat)} commands matched, {lost} not seen", flush=True)
-    finally:
-        try:
-            rospy.signal_shutdown("benchmark done")
-        except Exception:
-            pass
-        procs.stop_all()
-        log.close()
 
     table = [("measure", "robot", "figure", "target"), *rows]
     widths = [max(len(r[i]) for r in table) for i in range(4)]

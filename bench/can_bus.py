@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The CAN base against simple_sim, side by side in one run: CPU, frames per cycle, loop rate, relay.
 
-    python bench/can_bus.py [--port 11399] [--window 10] [--rounds 2] [--relay-rate 1000]
+    python bench/can_bus.py [--port PORT] [--window 10] [--rounds 2] [--relay-rate 1000]
 
 Starts its own roscore and the CAN device emulator of the 9-drive robot (rosrun thorvald_sim
 can_emulator, an SLCAN hub of pseudo-terminals), and stops everything it started. Needs the
@@ -22,6 +22,7 @@ workspace sourced. The bench itself joins the bus on the hub's second port as an
 
 import argparse
 import os
+import shutil
 import signal
 import statistics
 import sys
@@ -31,11 +32,12 @@ import time
 
 import can
 import rospy
-from base_driver import HELD, NINE, Bench, Processes, free_port, start_master  # the base_driver benchmark's tools
+from base_driver import HELD, NINE, Bench, ros_session  # the base_driver benchmark's tools
 from nav_msgs.msg import Odometry
 
 from thorvald_base.can.slcan import BufferedSlcanBus
 from thorvald_msgs.msg import CANFrame
+from thorvald_testing import poll
 
 RATES = (100, 200, 400)  # [Hz]
 TARGET_CPU_RATIO = 1.5
@@ -147,91 +149,84 @@ def relay(bench, ns, implement, rate):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--port", type=int, default=11399, help="first port to try for the roscore")
+    parser.add_argument("--port", type=int, default=None, help="the roscore's port (default: a free one)")
     parser.add_argument("--window", type=float, default=10.0, help="CPU measurement window [s]")
     parser.add_argument("--rounds", type=int, default=2, help="CAN / simple_sim alternations")
     parser.add_argument("--relay-rate", type=float, default=1000.0, help="relayed frames per second each way")
     args = parser.parse_args()
 
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))  # through the finally below: stop every process
-    port = free_port(args.port)
-    procs = Processes()
-    log = open(os.devnull, "w")
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))  # through ros_session's exit: stop every process
     links = tempfile.mkdtemp(prefix="thorvald_can_bench_")
     rows = []
     implement = None
     ok = True
-    try:
-        start_master(procs, log, port, "bench_can")
-        bench = Bench(procs, log)
-        procs.start(
-            ["rosrun", "thorvald_sim", "can_emulator", bench.robot_file(NINE), "--ports", "2", "--link-dir", links], log
-        )
-        deadline = time.time() + 60
-        while not os.path.exists(os.path.join(links, "port1")):
-            if time.time() > deadline:
-                raise RuntimeError("the CAN emulator did not come up")
-            time.sleep(0.2)
-        bench.can_params = {
-            "simple_sim": False,
-            "can_interface_type": "slcan",
-            "can_interface_name": os.path.join(links, "port0"),
-        }
-        implement = Implement(os.path.join(links, "port1"))
-        print(f"roscore on port {port}; {os.cpu_count()} cores; emulator ports in {links}", flush=True)
+    with ros_session("bench_can", port=args.port) as (master, procs):
+        try:
+            bench = Bench(procs)
+            procs.start(
+                ["rosrun", "thorvald_sim", "can_emulator", bench.robot_file(NINE), "--ports", "2", "--link-dir", links]
+            )
+            poll(lambda: os.path.exists(os.path.join(links, "port1")), 60, "the CAN emulator's ports")
+            bench.can_params = {
+                "simple_sim": False,
+                "can_interface_type": "slcan",
+                "can_interface_name": os.path.join(links, "port0"),
+            }
+            implement = Implement(os.path.join(links, "port1"))
+            print(f"roscore on port {master.port}; {os.cpu_count()} cores; emulator ports in {links}", flush=True)
 
-        cpu = {"can": [], "sim": []}
-        for r in range(args.rounds):
-            for kind in ("can", "sim"):
-                extra = bench.can_params if kind == "can" else {}
-                share, achieved = bench.cpu_and_rate(f"{kind}{r}", NINE, 50, args.window, **extra)
-                cpu[kind].append(share)
-                print(f"  {kind} round {r}: {share:.1f} % CPU, {achieved:.1f} Hz", flush=True)
-        can_cpu, sim_cpu = statistics.median(cpu["can"]), statistics.median(cpu["sim"])
-        ratio = can_cpu / sim_cpu
-        ok &= ratio <= TARGET_CPU_RATIO
-        rows.append(("CPU share at 50 Hz, SLCAN", "9 drives", f"{can_cpu:.1f} % of a core", ""))
-        rows.append(("CPU share at 50 Hz, simple_sim", "9 drives", f"{sim_cpu:.1f} % of a core", ""))
-        rows.append(("CAN / simple_sim", "9 drives", f"{ratio:.2f}", f"<= {TARGET_CPU_RATIO}"))
-        best = None
-        for rate in RATES:
-            share, achieved = bench.cpu_and_rate(f"canrate{rate}", NINE, rate, 5.0, **bench.can_params)
-            held = achieved >= HELD * rate
-            best = rate if held else best
+            cpu = {"can": [], "sim": []}
+            for r in range(args.rounds):
+                for kind in ("can", "sim"):
+                    extra = bench.can_params if kind == "can" else {}
+                    share, achieved = bench.cpu_and_rate(f"{kind}{r}", NINE, 50, args.window, **extra)
+                    cpu[kind].append(share)
+                    print(f"  {kind} round {r}: {share:.1f} % CPU, {achieved:.1f} Hz", flush=True)
+            can_cpu, sim_cpu = statistics.median(cpu["can"]), statistics.median(cpu["sim"])
+            ratio = can_cpu / sim_cpu
+            ok &= ratio <= TARGET_CPU_RATIO
+            rows.append(("CPU share at 50 Hz, SLCAN", "9 drives", f"{can_cpu:.1f} % of a core", ""))
+            rows.append(("CPU share at 50 Hz, simple_sim", "9 drives", f"{sim_cpu:.1f} % of a core", ""))
+            rows.append(("CAN / simple_sim", "9 drives", f"{ratio:.2f}", f"<= {TARGET_CPU_RATIO}"))
+            best = None
+            for rate in RATES:
+                share, achieved = bench.cpu_and_rate(f"canrate{rate}", NINE, rate, 5.0, **bench.can_params)
+                held = achieved >= HELD * rate
+                best = rate if held else best
+                rows.append(
+                    (
+                        f"~rate {rate} Hz, SLCAN",
+                        "9 drives",
+                        f"{achieved:.0f} Hz, {share:.0f} % CPU",
+                        "held" if held else "not held",
+                    )
+                )
+                print(f"  SLCAN at {rate} Hz: {achieved:.1f} Hz achieved, {share:.1f} % CPU", flush=True)
+            rows.append(("highest loop rate held, SLCAN", "9 drives", f"{best or 0} Hz", ""))
+
+            frames, (sent_in, got_in, sent_out, got_out, achieved) = relay(bench, "relay", implement, args.relay_rate)
+            rows.append(
+                ("frames per cycle, base_driver -> devices", "9 drives", f"{frames['base']:.1f}", "2 per controller")
+            )
+            rows.append(("frames per cycle, devices -> base", "9 drives", f"{frames['devices']:.1f}", ""))
+            lossless = got_in == sent_in and got_out == sent_out and achieved >= HELD * 50
+            ok &= lossless
+            rows.append(
+                ("relay, implement -> can_frames_device_r", f"{args.relay_rate:.0f}/s", f"{got_in} of {sent_in}", "all")
+            )
             rows.append(
                 (
-                    f"~rate {rate} Hz, SLCAN",
-                    "9 drives",
-                    f"{achieved:.0f} Hz, {share:.0f} % CPU",
-                    "held" if held else "not held",
+                    "relay, can_frames_device_t -> implement",
+                    f"{args.relay_rate:.0f}/s",
+                    f"{got_out} of {sent_out}",
+                    "all",
                 )
             )
-            print(f"  SLCAN at {rate} Hz: {achieved:.1f} Hz achieved, {share:.1f} % CPU", flush=True)
-        rows.append(("highest loop rate held, SLCAN", "9 drives", f"{best or 0} Hz", ""))
-
-        frames, (sent_in, got_in, sent_out, got_out, achieved) = relay(bench, "relay", implement, args.relay_rate)
-        rows.append(
-            ("frames per cycle, base_driver -> devices", "9 drives", f"{frames['base']:.1f}", "2 per controller")
-        )
-        rows.append(("frames per cycle, devices -> base", "9 drives", f"{frames['devices']:.1f}", ""))
-        lossless = got_in == sent_in and got_out == sent_out and achieved >= HELD * 50
-        ok &= lossless
-        rows.append(
-            ("relay, implement -> can_frames_device_r", f"{args.relay_rate:.0f}/s", f"{got_in} of {sent_in}", "all")
-        )
-        rows.append(
-            ("relay, can_frames_device_t -> implement", f"{args.relay_rate:.0f}/s", f"{got_out} of {sent_out}", "all")
-        )
-        rows.append(("loop rate during the relay", "9 drives", f"{achieved:.1f} Hz", "50 Hz"))
-    finally:
-        if implement is not None:
-            implement.close()
-        try:
-            rospy.signal_shutdown("benchmark done")
-        except Exception:
-            pass
-        procs.stop_all()
-        log.close()
+            rows.append(("loop rate during the relay", "9 drives", f"{achieved:.1f} Hz", "50 Hz"))
+        finally:
+            if implement is not None:
+                implement.close()
+    shutil.rmtree(links, ignore_errors=True)  # the emulator's links, once it has stopped
 
     table = [("measure", "robot / load", "figure", "target"), *rows]
     widths = [max(len(r[i]) for r in table) for i in range(4)]

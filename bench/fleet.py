@@ -37,14 +37,14 @@ import json
 import os
 import re
 import signal
-import subprocess
 import sys
-import tempfile
 import threading
 import time
 
-from base_driver import Processes, cpu_seconds, free_port, start_master
-from sim import children, cmdline, end_launch
+from base_driver import ros_session
+from sim import case_launch, check
+
+from thorvald_testing import children, cmdline, cpu_seconds, poll
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 STD = os.path.join(ROOT, "src", "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
@@ -85,15 +85,12 @@ def launch_file(n: int, lidar: bool, stack: str, rtf: float = 1.0):
         if stack == "fleet"
         else ""
     )
-    launch = tempfile.NamedTemporaryFile("w", suffix=".launch", delete=False)
-    launch.write(
+    return (
         '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'
         f'<arg name="world" value="flat"/><arg name="real_time_factor" value="{rtf:g}"/>'
         '<arg name="output" value="log"/>'
         f"</include>\n{robots}\n{fleet}</launch>\n"
     )
-    launch.close()
-    return launch
 
 
 def role_of(pid: int, master_pid: int) -> str:
@@ -117,16 +114,18 @@ def _ignore(_msg):
     pass
 
 
-def case(n: int, lidar: bool, stack: str, seconds: float, *, master_pid: int, rtf: float = 1.0):
-    """{figure: value} of one fleet."""
+def case(n: int, lidar: bool, stack: str, seconds: float, *, master, rtf: float = 1.0):
+    """{figure: value} of one fleet, on the benchmark's master."""
     import rospy  # noqa: PLC0415
     from diagnostic_msgs.msg import DiagnosticArray  # noqa: PLC0415
     from geometry_msgs.msg import Twist  # noqa: PLC0415
     from nav_msgs.msg import Odometry  # noqa: PLC0415
     from rosgraph_msgs.msg import Clock  # noqa: PLC0415
 
-    launch = launch_file(n, lidar, stack, rtf)
-    clock = {"t": None}
+    from thorvald_testing.topics import Latest  # noqa: PLC0415
+
+    xml = launch_file(n, lidar, stack, rtf)
+    clock = Latest("/clock", Clock, queue_size=1)
     solver = []  # the simulator's figure per /diagnostics window while measuring [s per simulated s]
     measuring = threading.Event()
 
@@ -136,10 +135,7 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master_pid: int, rt
                 values = {kv.key: kv.value for kv in status.values}
                 solver.append(float(values["solver CPU per simulated second [s]"]))
 
-    subs = [
-        rospy.Subscriber("/clock", Clock, lambda m: clock.__setitem__("t", m.clock.to_sec()), queue_size=1),
-        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=10),
-    ]
+    diagnostics = rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=10)
     moving = set()
     odometry = [
         rospy.Subscriber(f"/r{k}/odometry/base_raw", Odometry, lambda m, k=k: moving.add(k), queue_size=1)
@@ -155,16 +151,7 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master_pid: int, rt
         twist.linear.x, twist.angular.z = twist_of(k)
         twists.append(twist)
     stop = threading.Event()
-    output = tempfile.NamedTemporaryFile("w", prefix=f"bench_fleet_{n}_", suffix=".log", delete=False)
-    proc = subprocess.Popen(["roslaunch", launch.name], stdout=output, stderr=subprocess.STDOUT, start_new_session=True)
     label = f"{n} robots{' with lidars' if lidar else ''}, {stack}"
-    ok = False
-
-    def check():
-        if proc.poll() is not None:
-            with open(output.name, errors="replace") as f:
-                tail = f.read()[-3000:]
-            raise RuntimeError(f"{label}: the launch stopped (exit {proc.returncode}); {output.name} ends:\n{tail}")
 
     def command():  # 10 Hz of wall time: at real time, 10 Hz of simulated time
         next_at = time.monotonic()
@@ -174,55 +161,58 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master_pid: int, rt
             next_at += COMMAND_PERIOD
             stop.wait(max(0.0, next_at - time.monotonic()))
 
+    def now():
+        return clock.get().clock.to_sec()
+
     try:
-        threading.Thread(target=command, daemon=True).start()
-        deadline = time.monotonic() + 90 + 10 * n
-        retry = time.monotonic() + 30
-        while len(moving) < n:
-            check()
-            missing = [k for k in range(n) if k not in moving]
-            if time.monotonic() > deadline:
-                names = " ".join(f"r{k}" for k in missing)
-                raise RuntimeError(f"{label}: no odometry from {names}; see {output.name}")
-            if time.monotonic() > retry:
-                # rospy gives up a connection that failed while the machine was swamped (a hundred
-                # processes starting): subscribe again to the robots not heard from
-                for k in missing:
-                    odometry[k].unregister()
-                    odometry[k] = rospy.Subscriber(
-                        f"/r{k}/odometry/base_raw", Odometry, lambda m, k=k: moving.add(k), queue_size=1
-                    )
-                retry = time.monotonic() + 30
-            time.sleep(0.5)
-        for sub in odometry:
-            sub.unregister()
-        start = clock["t"]
-        while clock["t"] - start < WARM_UP:
-            check()
-            time.sleep(0.1)
-        pids = [*children(proc.pid), master_pid]
-        t0, w0, c0 = clock["t"], time.perf_counter(), cpu_by_role(pids, master_pid)
-        measuring.set()
-        while clock["t"] - t0 < seconds:
-            check()
-            if time.perf_counter() - w0 > 20 * seconds:
-                raise RuntimeError(f"{label}: {clock['t'] - t0:.1f} simulated s in {20 * seconds:.0f} wall s")
-            time.sleep(0.1)
-        t1, w1, c1 = clock["t"], time.perf_counter(), cpu_by_role(pids, master_pid)
-        measuring.clear()
-        if not solver:
-            raise RuntimeError(f"{label}: no /diagnostics from the simulator while measuring")
-        simulated = t1 - t0
-        per_robot = {role: (c1[role] - c0[role]) / simulated / n for role in ROLES}
-        per_robot["solver"] = sum(solver) / len(solver) / n
-        per_robot["simulator"] -= per_robot["solver"]  # the simulator process's CPU less its solver
-        ok = True
-        return {"rtf": simulated / (w1 - w0), "wall": w1 - w0, **per_robot}
+        with case_launch(xml, master, f"fleet_{n}_{'lidar_' if lidar else ''}{stack}") as launch:
+            threading.Thread(target=command, daemon=True).start()
+            retry = [time.monotonic() + 30]
+
+            def all_moving():
+                check(launch, label)
+                missing = [k for k in range(n) if k not in moving]
+                if missing and time.monotonic() > retry[0]:
+                    # rospy gives up a connection that failed while the machine was swamped (a hundred
+                    # processes starting): subscribe again to the robots not heard from
+                    for k in missing:
+                        odometry[k].unregister()
+                        odometry[k] = rospy.Subscriber(
+                            f"/r{k}/odometry/base_raw", Odometry, lambda m, k=k: moving.add(k), queue_size=1
+                        )
+                    retry[0] = time.monotonic() + 30
+                return not missing and clock.get() is not None
+
+            def not_moving():
+                names = " ".join(f"r{k}" for k in range(n) if k not in moving)
+                return f"{label}: odometry from every robot (none from {names or '-'}); see {launch.output}"
+
+            poll(all_moving, 90 + 10 * n, not_moving, interval=0.5)
+            for sub in odometry:
+                sub.unregister()
+            start = now()
+            poll(lambda: check(launch, label) or now() - start >= WARM_UP, 20 * WARM_UP, f"{label}: the warm-up")
+            pids = [*children(launch.proc.pid), master.proc.pid]
+            t0, w0, c0 = now(), time.perf_counter(), cpu_by_role(pids, master.proc.pid)
+            measuring.set()
+            while now() - t0 < seconds:
+                check(launch, label)
+                if time.perf_counter() - w0 > 20 * seconds:
+                    raise RuntimeError(f"{label}: {now() - t0:.1f} simulated s in {20 * seconds:.0f} wall s")
+                time.sleep(0.1)
+            t1, w1, c1 = now(), time.perf_counter(), cpu_by_role(pids, master.proc.pid)
+            measuring.clear()
+            if not solver:
+                raise RuntimeError(f"{label}: no /diagnostics from the simulator while measuring")
+            simulated = t1 - t0
+            per_robot = {role: (c1[role] - c0[role]) / simulated / n for role in ROLES}
+            per_robot["solver"] = sum(solver) / len(solver) / n
+            per_robot["simulator"] -= per_robot["solver"]  # the simulator process's CPU less its solver
+            return {"rtf": simulated / (w1 - w0), "wall": w1 - w0, **per_robot}
     finally:
         stop.set()
-        for endpoint in subs + odometry + pubs + scans:
+        for endpoint in [clock.sub, diagnostics, *odometry, *pubs, *scans]:
             endpoint.unregister()
-        end_launch(proc, launch, output, keep_log=not ok)
 
 
 def print_row(n, lidar, stack, r):
@@ -286,22 +276,12 @@ def main() -> int:
             for row in json.load(f):
                 results.setdefault((row["lidar"], row["stack"]), {})[row["robots"]] = row["figures"]
                 print_row(row["robots"], row["lidar"], row["stack"], row["figures"])
-    procs = Processes()
-    log = open(os.devnull, "w")
-    try:
-        port = free_port(11399)
-        master = start_master(procs, log, port, "bench_fleet", master_only=True)
+    with ros_session("bench_fleet", core_only=True) as (master, _):
         for n, lidar in cases:
             for stack in args.stacks:
-                r = case(n, lidar, stack, args.seconds, master_pid=master.pid, rtf=args.real_time_factor)
+                r = case(n, lidar, stack, args.seconds, master=master, rtf=args.real_time_factor)
                 results.setdefault((lidar, stack), {})[n] = r
                 print_row(n, lidar, stack, r)
-    finally:
-        import rospy  # noqa: PLC0415
-
-        rospy.signal_shutdown("done")
-        procs.stop_all()
-        log.close()
     if args.json:
         rows = [
             {"robots": n, "lidar": lidar, "stack": stack, "figures": r}

@@ -36,14 +36,15 @@ import os
 import signal
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 from typing import Optional
 
 import numpy as np
-from base_driver import Processes, cpu_seconds, free_port, start_master
-from sim import children, cmdline, end_launch, fleet_launch
+from base_driver import ros_session
+from sim import case_launch, check, fleet_launch
+
+from thorvald_testing import children, cmdline, cpu_seconds, poll
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 STD = os.path.join(ROOT, "src", "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
@@ -172,9 +173,7 @@ def raw_worker(name: str) -> int:
 # ---------------------------------------------------------------------------------------------
 # 2. the simulator node
 # ---------------------------------------------------------------------------------------------
-def node_case(
-    n: int, seconds: float, port: int, phases, *, sensors: bool = True, fleet_driver: bool = False, beside=None
-):
+def node_case(n: int, seconds: float, master, phases, *, sensors: bool = True, fleet_driver: bool = False, beside=None):
     """One launch of n robots, measured in phases one after the other, each reading its own topics:
     per phase (real-time factor, simulator CPU [s] per simulated second, {sensor: node CPU per
     simulated second} of robot r0, raw CPU per simulated second beside it or None). A phase: topic
@@ -185,11 +184,11 @@ def node_case(
     from rosgraph_msgs.msg import Clock  # noqa: PLC0415
     from rospy import AnyMsg  # noqa: PLC0415
 
-    env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
+    from thorvald_testing.topics import Latest  # noqa: PLC0415
+
     extras = f'<arg name="model_extras" value="{EXTRAS}"/>' if sensors else ""
-    launch = fleet_launch([(SPACING * k, 0) for k in range(n)], robot_args=extras, fleet_driver=fleet_driver)
-    clock = {"t": None}
-    sub = rospy.Subscriber("/clock", Clock, lambda m: clock.__setitem__("t", m.clock.to_sec()))
+    xml = fleet_launch([(SPACING * k, 0) for k in range(n)], robot_args=extras, fleet_driver=fleet_driver)
+    clock = Latest("/clock", Clock, queue_size=1)
     per_sensor = {}
     measuring = threading.Event()
 
@@ -204,69 +203,69 @@ def node_case(
 
     diagnostics = rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics)
     readers = []
-    output = tempfile.NamedTemporaryFile("w", prefix="bench_sensors_", suffix=".log", delete=False)
-    proc = subprocess.Popen(["roslaunch", launch.name], env=env, stdout=output, stderr=subprocess.STDOUT,
-                            start_new_session=True)  # fmt: skip
     results = []
+    label = f"{n} robots{' with sensors' if sensors else ''}{', fleet_driver' if fleet_driver else ''}"
+
+    def now():
+        return clock.get().clock.to_sec()
+
     try:
-        deadline = time.time() + 120 + 20 * n
-        while time.time() < deadline and clock["t"] is None:
-            if proc.poll() is not None:
-                raise RuntimeError(f"the launch stopped; see {output.name}")
-            time.sleep(0.2)
-        spawned = {f"/r{k}/odometry/gazebo" for k in range(n)}  # the simulator's topics of a spawned robot
-        while not spawned <= {t for t, _ in rospy.get_published_topics()}:
-            if time.time() > deadline or proc.poll() is not None:
-                raise RuntimeError(f"not every robot spawned; see {output.name}")
-            time.sleep(0.5)
-        time.sleep(5.0)  # their nodes up and settled
-        sim_pid = [pid for pid in children(proc.pid) if "/simulator" in cmdline(pid).split(" __")[0]]
-        for subscribe, raw_name in zip(phases, beside or [None] * len(phases)):
-            if subscribe == "all":
-                topics = [t for t, _ in rospy.get_published_topics() if t.startswith("/r") and _sensor_topic(t)]
-            else:
-                topics = [f"/r{k}/{s}" for k in range(n) for s in subscribe]
-            readers = [rospy.Subscriber(t, AnyMsg, lambda _m: None, queue_size=1) for t in topics]
-            time.sleep(3.0)
-            raw = RawBeside(raw_name) if raw_name else None
-            time.sleep(2.0 if raw else 0.0)  # its robot loaded, its readings begun
-            per_sensor.clear()
-            t0, w0, c0 = clock["t"], time.perf_counter(), sum(cpu_seconds(p, 0.0) for p in sim_pid)
-            measuring.set()
-            while clock["t"] - t0 < seconds and time.perf_counter() - w0 < 40 * seconds and proc.poll() is None:
-                time.sleep(0.1)
-            measuring.clear()
-            t1, w1, c1 = clock["t"], time.perf_counter(), sum(cpu_seconds(p, 0.0) for p in sim_pid)
-            raw_cpu = raw.result() if raw else None
-            simulated = t1 - t0
-            if simulated <= 0:
-                raise RuntimeError(f"simulated time stood still; see {output.name}")
-            sensors_cpu = {k: float(np.median(v)) for k, v in per_sensor.items()}
-            results.append((simulated / (w1 - w0), (c1 - c0) / simulated, sensors_cpu, raw_cpu))
-            for r in readers:
-                r.unregister()
-            readers = []
-        return results
+        with case_launch(xml, master, f"sensors_{n}_robots") as launch:
+            spawned = {f"/r{k}/odometry/gazebo" for k in range(n)}  # the simulator's topics of a spawned robot
+
+            def up():
+                check(launch, label)
+                return clock.get() is not None and spawned <= {t for t, _ in rospy.get_published_topics()}
+
+            poll(up, 120 + 20 * n, f"{label}: /clock and every robot spawned", interval=0.5)
+            time.sleep(5.0)  # their nodes up and settled
+            sim_pid = [pid for pid in children(launch.proc.pid) if "/simulator" in cmdline(pid).split(" __")[0]]
+            for subscribe, raw_name in zip(phases, beside or [None] * len(phases)):
+                if subscribe == "all":
+                    topics = [t for t, _ in rospy.get_published_topics() if t.startswith("/r") and _sensor_topic(t)]
+                else:
+                    topics = [f"/r{k}/{s}" for k in range(n) for s in subscribe]
+                readers = [rospy.Subscriber(t, AnyMsg, lambda _m: None, queue_size=1) for t in topics]
+                time.sleep(3.0)
+                raw = RawBeside(raw_name) if raw_name else None
+                time.sleep(2.0 if raw else 0.0)  # its robot loaded, its readings begun
+                per_sensor.clear()
+                t0, w0, c0 = now(), time.perf_counter(), sum(cpu_seconds(p, 0.0) for p in sim_pid)
+                measuring.set()
+                while now() - t0 < seconds and time.perf_counter() - w0 < 40 * seconds and launch.running():
+                    time.sleep(0.1)
+                measuring.clear()
+                t1, w1, c1 = now(), time.perf_counter(), sum(cpu_seconds(p, 0.0) for p in sim_pid)
+                raw_cpu = raw.result() if raw else None
+                check(launch, label)
+                simulated = t1 - t0
+                if simulated <= 0:
+                    raise RuntimeError(f"{label}: simulated time stood still; see {launch.output}")
+                sensors_cpu = {k: float(np.median(v)) for k, v in per_sensor.items()}
+                results.append((simulated / (w1 - w0), (c1 - c0) / simulated, sensors_cpu, raw_cpu))
+                for r in readers:
+                    r.unregister()
+                readers = []
+            return results
     finally:
         for r in readers:
             r.unregister()
-        sub.unregister()
+        clock.sub.unregister()
         diagnostics.unregister()
-        end_launch(proc, launch, output, keep_log=True)
 
 
 def _sensor_topic(topic: str) -> bool:
     return any(topic.endswith(s) for s in ("scan", "imu/data", "gps/fix", "velodyne_points", "image_raw", "points"))
 
 
-def sensors_part(seconds: float, port: int, rounds: int) -> bool:
+def sensors_part(seconds: float, master, rounds: int) -> bool:
     """Part 1, each sensor measured in rounds (one phase per sensor per round, the sensors taking
     turns); whether its target was met by the median over the rounds."""
     names = list(SENSOR_TOPICS)
     beside = [*names * rounds, None]  # the "all" phase last: no raw beside it
     phases = [SENSOR_TOPICS[name] if name else "all" for name in beside]
     ratios, raw, node, in_node = {}, {}, {}, {}
-    for name, (_, _, cpu, raw_cpu) in zip(beside, node_case(1, seconds, port, phases, beside=beside)):
+    for name, (_, _, cpu, raw_cpu) in zip(beside, node_case(1, seconds, master, phases, beside=beside)):
         by_name = {key.split(" ", 1)[1]: value for key, value in cpu.items()}  # "<kind> <name>" -> name
         if name:
             node_cpu = by_name.get(name, float("nan"))
@@ -299,7 +298,7 @@ def sensors_part(seconds: float, port: int, rounds: int) -> bool:
     return verdict
 
 
-def robots_part(n: int, seconds: float, port: int, stack: str) -> bool:
+def robots_part(n: int, seconds: float, master, stack: str) -> bool:
     """Part 2 with one stack ("per-robot": base_driver, twist_mux and robot_state_publisher per robot;
     "fleet": one fleet_driver for all); whether its targets were met."""
     fleet = stack == "fleet"
@@ -313,7 +312,7 @@ def robots_part(n: int, seconds: float, port: int, stack: str) -> bool:
     ]
     results = {}
     for label, subscribe, fitted in cases:
-        [(rtf, cpu, _, _)] = node_case(n, seconds, port, [subscribe], sensors=fitted, fleet_driver=fleet)
+        [(rtf, cpu, _, _)] = node_case(n, seconds, master, [subscribe], sensors=fitted, fleet_driver=fleet)
         results[label] = (rtf, cpu)
         print(f"{label:>36} {rtf:>6.2f}x {cpu:>9.3f}s", flush=True)
     bare, idle = results["no sensors fitted"][1], results["sensors fitted, none read"][1]
@@ -348,23 +347,13 @@ def main() -> int:
     if args.raw:
         return raw_worker(args.raw)
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
-    procs = Processes()
-    log = open(os.devnull, "w")
     ok = True
-    try:
-        port = free_port(11411)
-        start_master(procs, log, port, "bench_sensors", master_only=True)
+    with ros_session("bench_sensors", core_only=True) as (master, _):
         if args.part in (None, 1):
-            ok &= sensors_part(args.seconds, port, args.rounds)
+            ok &= sensors_part(args.seconds, master, args.rounds)
         if args.part in (None, 2):
             for stack in ("per-robot", "fleet") if args.stack == "both" else (args.stack,):
-                ok &= robots_part(args.robots, args.seconds, port, stack)
-    finally:
-        import rospy  # noqa: PLC0415
-
-        rospy.signal_shutdown("done")
-        procs.stop_all()
-        log.close()
+                ok &= robots_part(args.robots, args.seconds, master, stack)
     return 0 if ok else 1
 
 

@@ -21,15 +21,18 @@ Target: four robots at least 3 times real time on this 2-core machine.
 """
 
 import argparse
+import contextlib
 import os
+import shutil
 import signal
-import subprocess
 import sys
 import tempfile
 import threading
 import time
 
-from base_driver import Processes, cpu_seconds, free_port, start_master  # the base_driver benchmark's tools
+from base_driver import ros_session  # the base_driver benchmark's tools
+
+from thorvald_testing import Launch, children, cmdline, cpu_seconds, poll
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 STD = os.path.join(ROOT, "src", "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
@@ -98,10 +101,10 @@ def core(n: int, seconds: float):
         p.disconnect(c)
 
 
-def node(n: int, seconds: float, port: int, clock_rate: float):
+def node(n: int, seconds: float, master, clock_rate: float):
     """(real-time factor, simulator CPU [s] per simulated second, all nodes' CPU share [cores]).
 
-    Every case runs on the one master at port (rospy initialises once per process) with a launch
+    Every case runs on the benchmark's one master (rospy initialises once per process) with a launch
     of its own, stopped before the next case.
     """
     import rospy  # noqa: PLC0415
@@ -109,10 +112,10 @@ def node(n: int, seconds: float, port: int, clock_rate: float):
     from geometry_msgs.msg import Twist  # noqa: PLC0415
     from rosgraph_msgs.msg import Clock  # noqa: PLC0415
 
-    env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
-    launch = fleet_launch([grid(k) for k in range(n)], f'<arg name="clock_rate" value="{clock_rate:g}"/>')
-    clock = {"t": None}
-    sub = rospy.Subscriber("/clock", Clock, lambda m: clock.__setitem__("t", m.clock.to_sec()))
+    from thorvald_testing.topics import Latest  # noqa: PLC0415
+
+    xml = fleet_launch([grid(k) for k in range(n)], f'<arg name="clock_rate" value="{clock_rate:g}"/>')
+    clock = Latest("/clock", Clock, queue_size=1)
     solver = []  # the simulator's own figure per window: pybullet's solver's CPU [s] per simulated second
 
     def on_diagnostics(msg):
@@ -125,78 +128,65 @@ def node(n: int, seconds: float, port: int, clock_rate: float):
     diagnostics = rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics)
     pubs = [rospy.Publisher(f"/r{k}/nav_vel", Twist, queue_size=1) for k in range(n)]
     stop = threading.Event()
-    measured = False
-    output = tempfile.NamedTemporaryFile("w", prefix=f"bench_sim_{n}_robots_", suffix=".log", delete=False)
-    proc = subprocess.Popen(
-        ["roslaunch", launch.name],
-        env=env,
-        stdout=output,
-        stderr=subprocess.STDOUT,
-        start_new_session=True,
-    )
-
-    def check():
-        """Raises if the launch stopped (a required node, the simulator, died), with the end of its output."""
-        if proc.poll() is not None:
-            with open(output.name, errors="replace") as f:
-                tail = f.read()[-3000:]
-            raise RuntimeError(f"{n} robots: the launch stopped (exit {proc.returncode}); {output.name} ends:\n{tail}")
-
+    label = f"{n} robots"
     try:
-        twist = Twist()
-        twist.linear.x = 0.5
+        with case_launch(xml, master, f"sim_{n}_robots") as launch:
+            twist = Twist()
+            twist.linear.x = 0.5
 
-        def drive():  # faster than any mux timeout at any real-time factor reached here
-            while not stop.is_set():
-                for pub in pubs:
-                    pub.publish(twist)
-                time.sleep(0.01)
+            def drive():  # faster than any mux timeout at any real-time factor reached here
+                while not stop.is_set():
+                    for pub in pubs:
+                        pub.publish(twist)
+                    time.sleep(0.01)
 
-        threading.Thread(target=drive, daemon=True).start()
-        deadline = time.time() + 120 + 15 * n
-        while time.time() < deadline and (clock["t"] is None or sum(p.get_num_connections() for p in pubs) < n):
-            check()
-            time.sleep(0.2)
-        if clock["t"] is None:
-            raise RuntimeError(f"{n} robots: the simulator never published /clock")
-        time.sleep(3.0)  # spawned and driving
-        every = children(proc.pid)  # roslaunch starts every node in a session of its own
-        simulator = [pid for pid in every if "/simulator" in cmdline(pid).split(" __")[0]]
-        t0, w0 = clock["t"], time.perf_counter()
-        c0 = sum(cpu_seconds(p, missing=0.0) for p in simulator)
-        a0 = sum(cpu_seconds(p, missing=0.0) for p in every)
-        measuring.set()
-        # at least three of the simulator's /diagnostics windows (1 s of wall time each) for its solver figure
-        while (
-            (clock["t"] - t0 < seconds or len(solver) < 3)
-            and time.perf_counter() - w0 < 20 * seconds
-            and proc.poll() is None
-        ):
-            time.sleep(0.1)
-        check()
-        t1, w1 = clock["t"], time.perf_counter()
-        if t1 <= t0:
-            raise RuntimeError(f"{n} robots: /clock stood still for {w1 - w0:.0f} s; see {output.name}")
-        measuring.clear()
-        c1 = sum(cpu_seconds(p, missing=0.0) for p in simulator)
-        a1 = sum(cpu_seconds(p, missing=0.0) for p in every)
-        simulated = t1 - t0
-        measured = True
-        if not solver:
-            raise RuntimeError(f"{n} robots: no /diagnostics from the simulator while measuring")
-        in_node = sum(solver) / len(solver)
-        return simulated / (w1 - w0), (c1 - c0) / simulated, in_node, (a1 - a0) / (w1 - w0)
+            threading.Thread(target=drive, daemon=True).start()
+
+            def started():
+                check(launch, label)
+                return clock.get() is not None and sum(p.get_num_connections() for p in pubs) >= n
+
+            poll(started, 120 + 15 * n, f"{label}: /clock and every robot's nav_vel subscribed")
+            time.sleep(3.0)  # spawned and driving
+
+            def now():
+                return clock.get().clock.to_sec()
+
+            every = children(launch.proc.pid)  # roslaunch starts every node in a session of its own
+            simulator = [pid for pid in every if "/simulator" in cmdline(pid).split(" __")[0]]
+            t0, w0 = now(), time.perf_counter()
+            c0 = sum(cpu_seconds(p, missing=0.0) for p in simulator)
+            a0 = sum(cpu_seconds(p, missing=0.0) for p in every)
+            measuring.set()
+            # at least three of the simulator's /diagnostics windows (1 s of wall time each) for its solver figure
+            while (
+                (now() - t0 < seconds or len(solver) < 3)
+                and time.perf_counter() - w0 < 20 * seconds
+                and launch.running()
+            ):
+                time.sleep(0.1)
+            check(launch, label)
+            t1, w1 = now(), time.perf_counter()
+            if t1 <= t0:
+                raise RuntimeError(f"{label}: /clock stood still for {w1 - w0:.0f} s; see {launch.output}")
+            measuring.clear()
+            c1 = sum(cpu_seconds(p, missing=0.0) for p in simulator)
+            a1 = sum(cpu_seconds(p, missing=0.0) for p in every)
+            simulated = t1 - t0
+            if not solver:
+                raise RuntimeError(f"{label}: no /diagnostics from the simulator while measuring")
+            in_node = sum(solver) / len(solver)
+            return simulated / (w1 - w0), (c1 - c0) / simulated, in_node, (a1 - a0) / (w1 - w0)
     finally:
         stop.set()
-        sub.unregister()
+        clock.sub.unregister()
         diagnostics.unregister()
         for pub in pubs:
             pub.unregister()
-        end_launch(proc, launch, output, keep_log=not measured)
 
 
 def fleet_launch(positions, simulator_args: str = "", robot_args: str = "", fleet_driver: bool = False):
-    """A launch file (closed, for the caller to remove): simulator.launch as fast as it can, and
+    """A launch file's XML: simulator.launch as fast as it can, and
     robot.launch r0, r1, ... at positions [(x, y)], each with robot_args (launch XML) added; with
     fleet_driver, one fleet_driver process does every robot's base_driver, twist_mux and
     robot_state_publisher work."""
@@ -213,55 +203,49 @@ def fleet_launch(positions, simulator_args: str = "", robot_args: str = "", flee
             '\n  <include file="$(find thorvald_bringup)/launch/fleet_driver.launch">'
             f'<arg name="robots" value="{names}"/></include>'
         )
-    launch = tempfile.NamedTemporaryFile("w", suffix=".launch", delete=False)
-    launch.write(
+    return (
         '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'
         '<arg name="real_time_factor" value="0"/><arg name="output" value="log"/>'
         f"{simulator_args}</include>\n{robots}\n</launch>\n"
     )
-    launch.close()
-    return launch
 
 
-def end_launch(proc, launch, output, keep_log: bool) -> None:
-    """A case's launch stopped, its launch file removed, and its log closed (and removed unless kept:
-    the log of a case that failed)."""
-    stop_launch(proc)
-    os.unlink(launch.name)
-    output.close()
-    if not keep_log:
-        os.unlink(output.name)
-
-
-def stop_launch(proc) -> None:
-    """roslaunch stopped as Ctrl-C stops it, its nodes killed if it has not gone within a minute."""
-    proc.send_signal(signal.SIGINT)
+@contextlib.contextmanager
+def case_launch(xml: str, master, label: str):
+    """A case's launch file (xml) run on the benchmark's master through thorvald_testing.Launch, in a
+    folder of its own (ROS_HOME, the logs, roslaunch's output): yields the Launch, stops it and
+    everything it started on the way out, and removes the folder, or keeps it (and says where)
+    when the case failed."""
+    home = tempfile.mkdtemp(prefix=f"bench_{label}_")
+    path = os.path.join(home, "case.launch")
+    with open(path, "w") as f:
+        f.write(xml)
+    launch = Launch(home, path, port=master.port)
+    ok = False
     try:
-        proc.wait(timeout=60)
-    except subprocess.TimeoutExpired:
-        for pid in children(proc.pid):
-            os.kill(pid, signal.SIGKILL)
-        proc.kill()
+        yield launch
+        ok = True
+    finally:
+        launch.stop()
+        if ok:
+            shutil.rmtree(home, ignore_errors=True)
+        else:
+            print(f"{label}: the launch's output and logs are kept in {home}", file=sys.stderr)
 
 
-def children(pid):
-    out = subprocess.run(["pgrep", "-P", str(pid)], capture_output=True, text=True).stdout.split()
-    return [int(x) for x in out]
-
-
-def cmdline(pid):
-    try:
-        with open(f"/proc/{pid}/cmdline", "rb") as f:
-            return f.read().replace(b"\0", b" ").decode(errors="replace")
-    except OSError:
-        return ""
+def check(launch, label: str) -> None:
+    """Raises if the launch stopped (a required node, the simulator, died), with the end of its output."""
+    if not launch.running():
+        raise RuntimeError(
+            f"{label}: the launch stopped (exit {launch.proc.returncode}); {launch.output} ends:\n{launch.tail()}"
+        )
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated seconds measured per case")
     parser.add_argument("--robots", type=int, nargs="+", default=[1, 4, 9])
-    parser.add_argument("--clock-rate", type=float, default=100.0, help="the simulator's ~clock_rate [Hz] (100)")
+    parser.add_argument("--clock-rate", type=float, default=80.0, help="the simulator's ~clock_rate [Hz] (80, its default)")
     args = parser.parse_args()
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # the master and launches are stopped on the way out
     print(
@@ -269,15 +253,11 @@ def main() -> int:
         f" {'solver':>9} {'overhead':>9} {'solver/raw':>11} {'node/solver':>12} {'all nodes':>10}"
     )
     results = {}
-    procs = Processes()
-    log = open(os.devnull, "w")
-    try:
-        port = free_port(11399)
-        start_master(procs, log, port, "bench_sim", master_only=True)
+    with ros_session("bench_sim", core_only=True) as (master, _):
         for n in args.robots:
             raw_rtf, raw_cpu = raw(n, args.seconds)
             core_cpu = core(n, args.seconds)
-            node_rtf, node_cpu, solver, all_cpu = node(n, args.seconds, port, args.clock_rate)
+            node_rtf, node_cpu, solver, all_cpu = node(n, args.seconds, master, args.clock_rate)
             results[n] = (raw_rtf, node_rtf, raw_cpu, node_cpu)
             print(
                 f"{n:>6} {raw_rtf:>7.1f}x {node_rtf:>8.1f}x {raw_cpu:>9.3f}s {core_cpu:>10.3f}s {node_cpu:>10.3f}s"
@@ -285,12 +265,6 @@ def main() -> int:
                 f" {all_cpu:>7.2f} cores",
                 flush=True,
             )
-    finally:
-        import rospy  # noqa: PLC0415
-
-        rospy.signal_shutdown("done")
-        procs.stop_all()
-        log.close()
     ok = True
     worst = max(results[n][3] / results[n][2] for n in results)
     verdict = worst <= TARGET_OVERHEAD

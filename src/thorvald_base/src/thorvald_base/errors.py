@@ -2,7 +2,19 @@
 
 One hierarchy, in the style of python-can: nodes catch :class:`ThorvaldBaseError` at the top of
 ``main()``; command-line tools print its message as one line and exit 2.
+
+The calculator plugins' errors (PluginError and its kinds) are thorvald_model's, as the plugin
+mechanism is (thorvald_model.plugins: the robot file names the calculator); their names stay
+importable from here. base_driver meets them as a ConfigError of the robot file (load_calculator).
 """
+
+from thorvald_model.errors import (  # noqa: F401  (the names code written against this module imports)
+    PluginDescriptionError,
+    PluginError,
+    PluginImportError,
+    PluginNotFoundError,
+    PluginTypeError,
+)
 
 
 class ThorvaldBaseError(Exception):
@@ -11,34 +23,6 @@ class ThorvaldBaseError(Exception):
 
 class KinematicsError(ThorvaldBaseError):
     """A calculator cannot serve the drives it was given, or was used before initialize()."""
-
-
-class PluginError(ThorvaldBaseError):
-    """A calculator plugin cannot be found or loaded."""
-
-
-class PluginNotFoundError(PluginError):
-    """No package exports a calculator of that name; the message lists the known names."""
-
-    def __init__(self, name, known):
-        self.name = name
-        self.known = tuple(sorted(known))
-        listed = ", ".join(self.known) if self.known else "none (no package exports thorvald_base plugins)"
-        super().__init__(
-            f"unknown base_calculator '{name}': known calculators are {listed} (or give a 'python.module:Class')"
-        )
-
-
-class PluginImportError(PluginError):
-    """The module of a calculator cannot be imported or lacks the class."""
-
-
-class PluginTypeError(PluginError):
-    """The loaded class is not a BaseCalculator."""
-
-
-class PluginDescriptionError(PluginError):
-    """A package's plugin description file is missing or malformed."""
 
 
 class ParameterError(ThorvaldBaseError):

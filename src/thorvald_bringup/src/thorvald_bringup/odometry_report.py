@@ -22,6 +22,8 @@ from typing import List, Optional, Sequence, Tuple
 from thorvald_base.kinematics import DriveState
 from thorvald_model.datum import WGS84_A, WGS84_E2, earth_radii  # noqa: F401  (the constants: for tests)
 
+from .errors import ReportError
+
 # The paper's figures for its six-wheeled robot on tarmac (section 3.3.2).
 PAPER_TRUTH_DISTANCE = 80.2  # [m] by RTK-GNSS
 PAPER_ODOMETRY_DISTANCE = 81.0  # [m]
@@ -95,10 +97,6 @@ class Report:
     planned_distance: float = math.nan  # [m] of the manoeuvre's plan, when the recording drove it
     missing_states: int = 0  # base_driver cycles with odometry but no base_state in the recording
     figures_gnss: dict = field(default_factory=dict)  # name -> Figures against RTK-GNSS (when recorded)
-
-
-class ReportError(ValueError):
-    """The recording cannot make a report (missing topics, no manoeuvre in it)."""
 
 
 def manoeuvre_start(commands: Sequence[Tuple[float, float, float, float]]) -> float:

@@ -9,6 +9,10 @@ difference, for both estimators (lsq live from base_driver, paper replayed from 
 states), next to the paper's figures; Figures 8 and 9 are written as PNG.
 
 ``--bag FILE`` makes the report from an existing bag (pass ``--robot`` if it is another robot).
+
+Exit status 0 with the report; 2 with the reason on stderr (a robot file's problems, one per line;
+otherwise one line: an unknown robot, a drive that did not finish, with the end of its launch's
+log, or a recording that makes no report) and no traceback.
 """
 
 import argparse
@@ -18,11 +22,14 @@ import os
 import shutil
 import subprocess
 import sys
+import textwrap
 import time
 
 from thorvald_model import ConfigError, load_robot_config
 from thorvald_model.ports import free_port
 from thorvald_sim.as_built import PROFILES, as_built_for, describe_as_built
+
+from .errors import DriveError, ReportError, ThorvaldBringupError, UnknownRobot
 
 TARGET_DISTANCE_ERROR = 0.5  # [%] for lsq (the paper: 1.0 %)
 TARGET_END_POINT = 1.0  # [m] for lsq (the paper: 2.2 m)
@@ -78,7 +85,7 @@ def robot_file(args) -> str:
     config_dir = os.path.join(rospkg.RosPack().get_path("thorvald_model"), "config")
     path = os.path.join(config_dir, args.robot, args.robot + ".yaml")
     if not os.path.isfile(path):
-        raise LookupError(
+        raise UnknownRobot(
             f"no example robot {args.robot!r}; the examples are: {' '.join(sorted(os.listdir(config_dir)))}"
         )
     return path
@@ -120,7 +127,7 @@ def drive(args, model: str, bag: str) -> float:
         except subprocess.TimeoutExpired:
             os.killpg(proc.pid, 2)  # SIGINT: roslaunch stops its nodes, rosbag closes the bag
             proc.wait(timeout=60)
-            raise RuntimeError(f"the drive took longer than {args.timeout:g} s of wall time; see {log}") from None
+            raise DriveError(f"the drive took longer than {args.timeout:g} s of wall time; see {log}") from None
         except KeyboardInterrupt:
             os.killpg(proc.pid, 2)
             proc.wait(timeout=60)
@@ -130,9 +137,7 @@ def drive(args, model: str, bag: str) -> float:
         text = f.read()
     if "Verification drive of" not in text or not os.path.isfile(bag):
         tail = "\n".join(text.splitlines()[-25:])
-        raise RuntimeError(
-            f"the drive did not finish (no report from verification_drive or no bag); end of {log}:\n{tail}"
-        )
+        raise DriveError(f"the drive did not finish (no report from verification_drive or no bag); see {log}", tail)
     return wall
 
 
@@ -162,17 +167,25 @@ def report_json(report, as_built: str, world: str) -> dict:
 def main(argv=None) -> int:
     args = parser().parse_args(argv)
     try:
-        model = robot_file(args)
-        config = load_robot_config(model)
-        built = as_built_for(args.as_built, config)  # refused here, before anything starts
-        if args.as_built and args.as_built.partition(":")[0] not in PROFILES:
-            args.as_built = os.path.abspath(args.as_built)  # the spawn runs elsewhere (in ~/.ros)
+        return run(args)
     except ConfigError as e:
         print(e, file=sys.stderr)  # FILE: key path: value: rule, as every command that reads a robot file
         return 2
-    except LookupError as e:
+    except ThorvaldBringupError as e:
         print(f"odometry_report: {e}", file=sys.stderr)
+        if isinstance(e, DriveError) and e.log_tail:  # what the launch said last: why the drive stopped
+            print(textwrap.indent(e.log_tail, "  | "), file=sys.stderr)
         return 2
+
+
+def run(args) -> int:
+    """The report the arguments ask for; ConfigError (a robot or as-built file) or ThorvaldBringupError
+    (an unknown robot, a drive that did not finish, a recording that makes no report) if none."""
+    model = robot_file(args)
+    config = load_robot_config(model)
+    built = as_built_for(args.as_built, config)  # refused here, before anything starts
+    if args.as_built and args.as_built.partition(":")[0] not in PROFILES:
+        args.as_built = os.path.abspath(args.as_built)  # the spawn runs elsewhere (in ~/.ros)
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
     name = os.path.splitext(os.path.basename(model))[0]
@@ -181,37 +194,28 @@ def main(argv=None) -> int:
         wall = None
     else:
         if shutil.which("roslaunch") is None:
-            print("odometry_report: roslaunch not found: source the workspace's devel/setup.bash", file=sys.stderr)
-            return 2
+            raise DriveError("roslaunch not found: source the workspace's devel/setup.bash")
         bag = os.path.join(out, "odometry_report.bag")
-        try:
-            wall = drive(args, model, bag)
-        except RuntimeError as e:
-            print(f"odometry_report: {e}", file=sys.stderr)
-            return 1
+        wall = drive(args, model, bag)
     # ROS's Python (rosbag, the calculators' plugin loader) only now: --help and bad robots stay fast
     from thorvald_base.plugins import load_calculator  # noqa: PLC0415
     from thorvald_base.verification import commanded_path, plan_for  # noqa: PLC0415
 
-    from .odometry_report import PAPER_SEED, ReportError, format_report, make_report  # noqa: PLC0415
+    from .odometry_report import PAPER_SEED, format_report, make_report  # noqa: PLC0415
     from .report_bag import read_recording  # noqa: PLC0415
     from .report_plots import figure8, figure9  # noqa: PLC0415
 
-    try:
-        recording = read_recording(bag, robot=name)
-        drives = {len(s[1]) for s in recording.states}
-        if drives != {len(config.drives)}:
-            raise ReportError(
-                f"{bag}: base_state has {', '.join(map(str, sorted(drives)))} drives, {name} has {len(config.drives)}: "
-                "pass the bag's robot with --robot or --robot-model"
-            )
-        calculators = {e: load_calculator(config, estimator=e, seed=PAPER_SEED) for e in ("lsq", "paper")}
-        report = make_report(recording, calculators)
-        if wall is not None or args.plan:
-            report.planned_distance = commanded_path(plan_for(config)[1])[1]
-    except ReportError as e:
-        print(f"odometry_report: {e}", file=sys.stderr)
-        return 1
+    recording = read_recording(bag, robot=name)
+    drives = {len(s[1]) for s in recording.states}
+    if drives != {len(config.drives)}:
+        raise ReportError(
+            f"{bag}: base_state has {', '.join(map(str, sorted(drives)))} drives, {name} has {len(config.drives)}: "
+            "pass the bag's robot with --robot or --robot-model"
+        )
+    calculators = {e: load_calculator(config, estimator=e, seed=PAPER_SEED) for e in ("lsq", "paper")}
+    report = make_report(recording, calculators)
+    if wall is not None or args.plan:
+        report.planned_distance = commanded_path(plan_for(config)[1])[1]
     print()
     print(format_report(report, (TARGET_DISTANCE_ERROR, TARGET_END_POINT)))
     if args.as_built:

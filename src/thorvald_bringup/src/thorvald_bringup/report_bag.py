@@ -14,7 +14,8 @@ import rosbag
 from thorvald_base.bag_topics import topics_by_ending
 from thorvald_base.conversions import quaternion_yaw
 
-from .odometry_report import Path, Recording, ReportError, gnss_path
+from .errors import ReportError
+from .odometry_report import Path, Recording, gnss_path
 
 ENDINGS = {
     "fix": "gps/fix",

@@ -108,7 +108,8 @@ def test_odometry_report_from_a_bag_prints_the_table_and_writes_figures_8_and_9(
 def test_odometry_report_refuses_a_bag_of_another_robot_and_a_bad_robot_with_one_line(tmp_path, drive):
     write_bag(tmp_path / "drive.bag", drive)
     r = run_report("--bag", str(tmp_path / "drive.bag"), "--robot", "thorvald_ii_4wd4ws_std", "--out", str(tmp_path))
-    assert r.returncode == 1
+    assert r.returncode == 2
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert r.stderr.strip().endswith(
         "base_state has 6 drives, thorvald_ii_4wd4ws_std has 4: pass the bag's robot with --robot or --robot-model"
     )
@@ -119,4 +120,20 @@ def test_odometry_report_refuses_a_bag_of_another_robot_and_a_bad_robot_with_one
     bad.write_text("base_calculator: 5\n")
     r = run_report("--robot-model", str(bad), "--bag", str(tmp_path / "drive.bag"), "--out", str(tmp_path))
     assert r.returncode == 2 and str(bad) in r.stderr and "Traceback" not in r.stderr
+    assert not os.path.exists(tmp_path / "figure8_paths.png")
+
+
+def test_odometry_report_refuses_a_calculator_it_cannot_load_as_a_problem_of_the_robot_file(tmp_path, drive, capsys):
+    """The bag reads, then the robot's calculator cannot be loaded: the robot file's problem, exit 2."""
+    from thorvald_bringup.odometry_report_cli import main  # noqa: PLC0415
+
+    write_bag(tmp_path / "drive.bag", drive)
+    with open(robot().source) as f:
+        text = f.read()
+    assert 'base_calculator: "pltf_clc_std::PltfClcStd"' in text
+    bad = tmp_path / "robot.yaml"
+    bad.write_text(text.replace('base_calculator: "pltf_clc_std::PltfClcStd"', 'base_calculator: "nowhere::Nothing"'))
+    assert main(["--robot-model", str(bad), "--bag", str(tmp_path / "drive.bag"), "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}: base_calculator: 'nowhere::Nothing': must name a calculator plugin: " in err
     assert not os.path.exists(tmp_path / "figure8_paths.png")

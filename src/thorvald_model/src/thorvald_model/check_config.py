@@ -8,6 +8,11 @@ With ``--model-extras`` (a model_extras file, e.g. the user's sensors) or ``--tf
 robot's URDF is generated as model.launch generates it and checked as check_urdf would
 (:mod:`thorvald_model.urdf_check`): a joint naming a link that does not exist is reported with
 the joint, the link and the closest existing names, as it would stop the robot's launch.
+
+Every file is also checked against its calculator's own layout rules: the ``base_calculator`` class
+is loaded by name through the plugin mechanism base_driver uses (:mod:`thorvald_model.plugins`, a
+dynamic load: this package never imports thorvald_base), and a calculator that cannot be loaded is
+a problem of the file. So a file base_driver would refuse is refused here too, always.
 """
 
 import argparse
@@ -21,6 +26,7 @@ from .check_report import report
 from .config import RobotConfig, load_robot_config
 from .description import XacroError, generate_urdf
 from .errors import ConfigError
+from .plugins import calculator_loader, calculator_problems
 
 
 def summary(config: RobotConfig) -> dict:
@@ -107,16 +113,6 @@ def format_details(config: RobotConfig) -> str:
     return "\n".join(lines)
 
 
-def calculator_problems(config: RobotConfig) -> list:
-    """The layout rules the robot's calculator declares (its plugin, found as base_driver finds it),
-    beyond the rules every calculator shares, which the loader checked."""
-    try:
-        from thorvald_base.plugins import calculator_layout_problems  # noqa: PLC0415  (the plugins' package)
-    except ImportError:  # thorvald_model alone: the shared rules are all there is to check
-        return []
-    return calculator_layout_problems(config)
-
-
 def main(argv: Optional[List[str]] = None) -> int:
     parser = argparse.ArgumentParser(
         prog="check_config", description="Validate Thorvald robot configuration files and summarise the robots."
@@ -136,10 +132,11 @@ def main(argv: Optional[List[str]] = None) -> int:
     describe = bool(args.model_extras) or args.tf_prefix is not None
 
     configs, descriptions, failed = [], {}, 0
+    calculators = calculator_loader()  # one search of the workspace's exports for every file
     for path in args.files:
         try:
             config = load_robot_config(path)
-            problems = calculator_problems(config)
+            problems = calculator_problems(config, calculators)
             if problems:
                 raise ConfigError(path, problems)
             if describe:

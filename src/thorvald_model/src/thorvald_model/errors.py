@@ -50,3 +50,37 @@ class ConfigError(ThorvaldModelError):
         lines = [p.format(source) for p in self.problems]
         header = "{}: invalid {} ({} problem{}):".format(source, what, len(lines), "" if len(lines) == 1 else "s")
         super().__init__("\n".join([header] + ["  " + line for line in lines]))
+
+
+class PluginError(ThorvaldModelError):
+    """A plugin the robot file names (``base_calculator``) cannot be found or loaded
+    (:mod:`thorvald_model.plugins`).
+
+    ``rule`` is the broken rule in words, without the plugin's name, for a :class:`Problem` of the
+    key that names it; the message is the rule with the plugin's name.
+    """
+
+    def __init__(self, message: str, rule: str = ""):
+        super().__init__(message)
+        self.rule = rule or message
+
+
+class PluginNotFoundError(PluginError):
+    """No package exports a plugin of that name; the message lists the known names."""
+
+    def __init__(self, message: str, rule: str, name: str, known: Sequence[str]):
+        super().__init__(message, rule)
+        self.name = name
+        self.known = tuple(sorted(known))
+
+
+class PluginImportError(PluginError):
+    """The module of a plugin cannot be imported or lacks the class."""
+
+
+class PluginTypeError(PluginError):
+    """The loaded class is not a subclass of the plugins' base class, or cannot be constructed."""
+
+
+class PluginDescriptionError(PluginError):
+    """A package's plugin description file is missing or malformed."""

@@ -47,7 +47,10 @@ def test_the_calculators_own_layout_rules_are_checked_too(tmp_path, capsys):
     assert f"{path}: base_calculator: 'pltf_clc_2wdiff::PltfClc2WDiff': the differential calculator serves" in err
     path.write_text(yaml.safe_dump({"base_calculator": "nowhere::Nothing", "motor_drives": four_drives()}))
     assert main([str(path)]) == 2
-    assert "unknown base_calculator 'nowhere::Nothing': known calculators are" in capsys.readouterr().err
+    assert (
+        f"{path}: base_calculator: 'nowhere::Nothing': must name a calculator plugin: known calculators are"
+        in capsys.readouterr().err
+    )
 
 
 def test_several_files_print_a_table(capsys):

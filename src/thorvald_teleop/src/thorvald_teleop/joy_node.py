@@ -26,7 +26,9 @@ import rospy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from sensor_msgs.msg import Joy
 
-from .joystick import DeviceUnavailable, JoystickReader, JoystickState, PublishSchedule, check_settings
+from .errors import DeviceUnavailable, ThorvaldTeleopError
+from .joystick import JoystickReader, JoystickState, PublishSchedule, check_settings
+from .teleop import parameter_number
 
 RETRY_PERIOD = 1.0  # [s] between attempts to open a missing device
 MAX_WAIT = 0.1  # [s] longest wait for events, so shutdown is seen quickly
@@ -37,9 +39,9 @@ class JoyNode:
     def __init__(self):
         self.dev = str(rospy.get_param("~dev", "/dev/input/js0"))
         settings, warnings = check_settings(
-            float(rospy.get_param("~deadzone", 0.05)),
-            float(rospy.get_param("~autorepeat_rate", 0.0)),
-            float(rospy.get_param("~coalesce_interval", 0.001)),
+            parameter_number("deadzone", rospy.get_param("~deadzone", 0.05)),
+            parameter_number("autorepeat_rate", rospy.get_param("~autorepeat_rate", 0.0)),
+            parameter_number("coalesce_interval", rospy.get_param("~coalesce_interval", 0.001)),
         )
         for w in warnings:
             rospy.logwarn("joy_node: %s", w)
@@ -194,7 +196,11 @@ class JoyNode:
 
 def main():
     rospy.init_node("joy_node")
-    node = JoyNode()
+    try:
+        node = JoyNode()
+    except ThorvaldTeleopError as e:  # a parameter that cannot be used (a missing device is waited for)
+        rospy.logfatal("joy_node: refusing to start: %s", e)
+        return 1
     try:
         node.run()
     finally:

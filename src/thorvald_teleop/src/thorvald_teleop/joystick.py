@@ -27,6 +27,8 @@ import os
 import struct
 from typing import List, NamedTuple, Optional, Tuple
 
+from .errors import DeviceUnavailable
+
 JS_EVENT_BUTTON = 0x01
 JS_EVENT_AXIS = 0x02
 JS_EVENT_INIT = 0x80
@@ -197,15 +199,6 @@ class PublishSchedule:
     def published(self, now: float) -> None:
         self.deadline = None
         self.last_published = now
-
-
-class DeviceUnavailable(Exception):
-    """The device is missing or went away; ``reason`` says why (for logs and diagnostics)."""
-
-    def __init__(self, path: str, reason: str):
-        super().__init__(f"{path}: {reason}")
-        self.path = path
-        self.reason = reason
 
 
 # read errors that mean the device went away (ENODEV: unplugged joystick)

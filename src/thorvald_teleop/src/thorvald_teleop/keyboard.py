@@ -19,6 +19,8 @@ The rules:
 import math
 from typing import Dict, List, NamedTuple, Optional, Tuple
 
+from .errors import TeleopConfigError
+
 
 class Velocity(NamedTuple):
     """A planar velocity command: linear x, y [m/s] and angular z [rad/s]."""
@@ -137,11 +139,11 @@ class KeyboardTeleop:
     ):
         for name, value in (("speed", speed), ("turn", turn), ("rate", rate), ("key_timeout", key_timeout)):
             if not (value > 0 and math.isfinite(value)):
-                raise ValueError(f"{name} must be a positive number, not {value!r}")
+                raise TeleopConfigError(f"{name} must be a positive number, not {value!r}")
         if not speed <= max_speed:
-            raise ValueError(f"speed {speed!r} m/s is above max_speed {max_speed!r} m/s")
+            raise TeleopConfigError(f"speed {speed!r} m/s is above max_speed {max_speed!r} m/s")
         if not turn <= max_turn:
-            raise ValueError(f"turn {turn!r} rad/s is above max_turn {max_turn!r} rad/s")
+            raise TeleopConfigError(f"turn {turn!r} rad/s is above max_turn {max_turn!r} rad/s")
         self.speed = float(speed)
         self.turn = float(turn)
         self.period = 1.0 / float(rate)

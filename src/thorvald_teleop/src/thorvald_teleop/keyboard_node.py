@@ -46,7 +46,9 @@ import warnings
 import rospy
 from geometry_msgs.msg import Twist
 
+from .errors import ThorvaldTeleopError
 from .keyboard import HELP, QUIT, SPEED, KeyboardTeleop, Velocity, split_keys
+from .teleop import parameter_number
 
 NAME = "teleop_keyboard"
 TOPIC = "teleop_joy/cmd_vel"
@@ -171,20 +173,15 @@ def main(argv=None) -> int:
     try:
         # our own signal handling: the terminal is restored and the robot stopped before exiting
         rospy.init_node(NAME, argv=argv, disable_signals=True)
-        try:
-            teleop = KeyboardTeleop(
-                speed=float(rospy.get_param("~speed", 0.5)),
-                turn=float(rospy.get_param("~turn", 0.5)),
-                rate=float(rospy.get_param("~rate", 20.0)),
-                key_timeout=float(rospy.get_param("~key_timeout", 0.6)),
-                max_speed=float(rospy.get_param("~max_speed", 2.0)),
-                max_turn=float(rospy.get_param("~max_turn", 2.0)),
-            )
-        except (TypeError, ValueError) as e:
-            rospy.logfatal("%s: bad parameter: %s", NAME, e)
-            rospy.signal_shutdown("bad parameter")
-            return EXIT_BAD_PARAMETER
+        defaults = {"speed": 0.5, "turn": 0.5, "rate": 20.0, "key_timeout": 0.6, "max_speed": 2.0, "max_turn": 2.0}
+        teleop = KeyboardTeleop(
+            **{name: parameter_number(name, rospy.get_param("~" + name, value)) for name, value in defaults.items()}
+        )
         node = KeyboardNode(teleop, RawTerminal(sys.stdin.fileno()))
+    except ThorvaldTeleopError as e:  # a parameter that cannot be used; the terminal is not touched yet
+        rospy.logfatal("%s: bad parameter: %s", NAME, e)
+        rospy.signal_shutdown("bad parameter")
+        return EXIT_BAD_PARAMETER
     except KeyboardInterrupt:  # Ctrl-C while waiting for the master, before the terminal was touched
         rospy.signal_shutdown("interrupted")
         return 130

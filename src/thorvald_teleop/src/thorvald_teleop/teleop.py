@@ -12,12 +12,12 @@ import math
 from dataclasses import dataclass, field
 from typing import Dict, Optional, Sequence, Tuple
 
+from .errors import TeleopConfigError
+
+__all__ = ["ZERO", "Actions", "TeleopConfig", "TeleopConfigError", "TeleopCore", "parameter_number"]
+
 Twist3 = Tuple[float, float, float]  # vx [m/s], vy [m/s], wz [rad/s]
 ZERO: Twist3 = (0.0, 0.0, 0.0)
-
-
-class TeleopConfigError(ValueError):
-    """A controller file or parameter that cannot be used; the message names the key."""
 
 
 def _axes(value, name: str, keys: Sequence[str], default: Dict[str, float]) -> Dict[str, float]:
@@ -37,6 +37,16 @@ def _axes(value, name: str, keys: Sequence[str], default: Dict[str, float]) -> D
             out[k] = v
         return out
     raise TeleopConfigError(f"~{name}: {value!r}: must be a number or a map of {list(keys)}")
+
+
+def parameter_number(name: str, value) -> float:
+    """A node's numeric parameter ``~name`` as a float; TeleopConfigError naming it if it is no number."""
+    if isinstance(value, bool):
+        raise TeleopConfigError(f"~{name}: {value!r}: must be a number")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise TeleopConfigError(f"~{name}: {value!r}: must be a number") from None
 
 
 def _index(params: dict, name: str, default: int) -> int:

@@ -19,7 +19,8 @@ from sensor_msgs.msg import Joy
 from std_msgs.msg import Bool
 from std_srvs.srv import Trigger
 
-from .teleop import Actions, TeleopConfig, TeleopConfigError, TeleopCore
+from .errors import ThorvaldTeleopError
+from .teleop import Actions, TeleopConfig, TeleopCore
 
 WARN_PERIOD = 5.0  # [s]
 
@@ -86,7 +87,7 @@ def main():
     rospy.init_node("teleop_node")
     try:
         TeleopNode()
-    except TeleopConfigError as e:
+    except ThorvaldTeleopError as e:
         rospy.logfatal("teleop_node: refusing to start: %s", e)
         return 1
     rospy.spin()

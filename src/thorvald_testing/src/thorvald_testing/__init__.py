@@ -3,9 +3,17 @@
 * :func:`free_port`: a TCP port nobody listens on, for a ROS master of a test's own (outside the
   ephemeral range, so no node takes it meanwhile: thorvald_model.ports);
 * :func:`poll`: wait for a condition with a deadline, failing with what was awaited;
-* :func:`ros_env`, :func:`ros_master`: a private ROS master (its own port and ROS_HOME);
-* :class:`Launch`: roslaunch in a session of its own, stopped with everything it started;
-* :func:`stop_group`, :func:`processes_naming`, :func:`kill_processes_naming`: ending processes.
+* :func:`ros_env`, :class:`Master`, :func:`ros_master`: a private ROS master (its own port and
+  ROS_HOME; roscore, or a bare rosmaster without rosout);
+* :class:`Launch`: roslaunch in a session of its own (on a master of its own, or on a running one),
+  stopped with everything it started;
+* :class:`Processes`: processes started each in a session of its own, all stopped at the end;
+* :func:`stop_group`, :func:`group_members`, :func:`processes_naming`, :func:`kill_processes_naming`:
+  ending processes;
+* :func:`children`, :func:`cmdline`, :func:`cpu_seconds`: what a process started and what it cost.
+
+The benchmarks (bench/) use the same pieces, so a benchmark and a test start, wait for and stop
+ROS processes one way.
 
 Nothing here sleeps to let something happen: every wait polls until a deadline, because the tests
 run on a machine shared with other work. Standard library and thorvald_model.ports (and the ROS
@@ -62,32 +70,59 @@ def master_is_up(uri: str) -> bool:
         return False
 
 
+class Master:
+    """A ROS master of its own, up when the constructor returns: roscore (or, core_only, a bare
+    ``rosmaster --core``: no rosout, nothing but the master to measure) on port (default: a free
+    one), ROS_HOME in home, in a session of its own, its output in home/roscore.out. ``env`` is the
+    environment to run processes on it with; :meth:`stop` ends it and what it started."""
+
+    def __init__(self, home, core_only: bool = False, port: Optional[int] = None, base=None):
+        self.home = str(home)
+        self.port = free_port() if port is None else port
+        self.env = ros_env(home, self.port, base)
+        self.uri = self.env["ROS_MASTER_URI"]
+        self.output = os.path.join(self.home, "roscore.out")
+        command = ["rosmaster", "--core"] if core_only else ["roscore"]
+        with open(self.output, "w") as out:
+            self.proc = subprocess.Popen(
+                [*command, "-p", str(self.port)],
+                env=self.env,
+                stdin=subprocess.DEVNULL,
+                stdout=out,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
+            )
+
+        def up():
+            if self.proc.poll() is not None:
+                with open(self.output) as f:
+                    raise AssertionError(f"{command[0]} exited:\n" + f.read()[-3000:])
+            return master_is_up(self.uri)
+
+        try:
+            poll(up, START, "the ROS master")
+        except BaseException:
+            self.stop()
+            raise
+
+    def stop(self) -> None:
+        stop_group(self.proc)
+
+    def __enter__(self) -> "Master":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+
 def ros_master(home) -> Iterator[Dict[str, str]]:
     """Generator (for a pytest fixture): roscore on a free port with ROS_HOME in home; yields the
     environment to run processes with, and stops roscore when resumed."""
-    env = ros_env(home, free_port())
-    out_path = os.path.join(str(home), "roscore.out")
-    with open(out_path, "w") as out:
-        core = subprocess.Popen(
-            ["roscore", "-p", env["ROS_MASTER_URI"].rsplit(":", 1)[1]],
-            env=env,
-            stdin=subprocess.DEVNULL,
-            stdout=out,
-            stderr=subprocess.STDOUT,
-            start_new_session=True,
-        )
+    master = Master(home)
     try:
-
-        def up():
-            if core.poll() is not None:
-                with open(out_path) as f:
-                    raise AssertionError("roscore exited:\n" + f.read()[-3000:])
-            return master_is_up(env["ROS_MASTER_URI"])
-
-        poll(up, START, "the ROS master")
-        yield env
+        yield master.env
     finally:
-        stop_group(core)
+        master.stop()
 
 
 def children(pid: int) -> List[int]:
@@ -95,20 +130,65 @@ def children(pid: int) -> List[int]:
     return [int(p) for p in out.stdout.split()]
 
 
+def cmdline(pid: int) -> str:
+    """A process's command line, its arguments joined by spaces; "" if it has gone."""
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as f:
+            return f.read().replace(b"\0", b" ").decode(errors="replace")
+    except OSError:
+        return ""
+
+
+CLK_TCK = os.sysconf("SC_CLK_TCK")  # [ticks/s] of /proc/<pid>/stat's times
+
+
+def cpu_seconds(pid: int, missing: Optional[float] = None) -> float:
+    """CPU time [s] a process has used, user and system (/proc/<pid>/stat fields 14 and 15); missing
+    if it has gone (None: OSError)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()  # after the command name, which may hold spaces
+    except OSError:
+        if missing is None:
+            raise
+        return missing
+    return (int(fields[11]) + int(fields[12])) / CLK_TCK
+
+
+def group_members(pgid: int) -> List[int]:
+    """The live processes of a process group (zombies, already dead, left out)."""
+    out = subprocess.run(["pgrep", "-g", str(pgid)], capture_output=True, text=True)
+    live = []
+    for pid in (int(p) for p in out.stdout.split()):
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                state = f.read().rsplit(")", 1)[1].split()[0]
+        except (OSError, IndexError):
+            continue
+        if state != "Z":
+            live.append(pid)
+    return live
+
+
 def stop_group(proc: subprocess.Popen, grace: float = 10.0) -> None:
     """Ends a process started in a session of its own, and its children: SIGINT to its group (roscore
-    and roslaunch stop what they started), SIGKILL to whatever is left after grace [s]."""
+    and roslaunch stop what they started), SIGKILL to whatever is left after grace [s], the leader's
+    children and the members of its group that outlived it (a shell's background job ignores SIGINT)."""
     kids = children(proc.pid)
+    deadline = time.monotonic() + grace
     if proc.poll() is None:
         try:
             os.killpg(proc.pid, signal.SIGINT)
             proc.wait(timeout=grace)
-            return
         except subprocess.TimeoutExpired:
             pass
         except ProcessLookupError:
             proc.wait(timeout=grace)
-            return
+        if proc.poll() is not None:  # the leader has gone: the rest of its group has what is left of grace
+            while group_members(proc.pid) and time.monotonic() < deadline:
+                time.sleep(0.02)
+            if not group_members(proc.pid):
+                return
     for pid in kids:
         try:
             os.kill(pid, signal.SIGKILL)
@@ -141,13 +221,59 @@ def kill_processes_naming(marker: str) -> List[str]:
     return killed
 
 
-class Launch:
-    """``roslaunch -p PORT FILE ARGS`` on a master of its own (started by roslaunch), in a session of
-    its own, its output in home/roslaunch.out. :meth:`stop` ends it and everything it started."""
+class Processes:
+    """Processes started each in a session of its own (so each stops with everything it started),
+    with env (default: this process's environment); :meth:`stop_all` ends them, the last first."""
 
-    def __init__(self, home, launch_file: str, args: Sequence[str] = (), env: Optional[Dict[str, str]] = None):
+    def __init__(self, env: Optional[Dict[str, str]] = None):
+        self.env = env
+        self.procs: List[subprocess.Popen] = []
+
+    def start(self, args: Sequence[str], out=subprocess.DEVNULL) -> subprocess.Popen:
+        """args started with its output (and errors) to out (a file, or DEVNULL)."""
+        proc = subprocess.Popen(
+            list(args), env=self.env, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )  # fmt: skip
+        self.procs.append(proc)
+        return proc
+
+    def stop(self, proc: subprocess.Popen, grace: float = 10.0) -> None:
+        """proc and its group ended (stop_group); it is forgotten."""
+        try:
+            stop_group(proc, grace)
+        finally:
+            if proc in self.procs:
+                self.procs.remove(proc)
+
+    def stop_all(self) -> None:
+        for proc in reversed(list(self.procs)):
+            self.stop(proc)
+
+    def __enter__(self) -> "Processes":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop_all()
+
+
+class Launch:
+    """``roslaunch -p PORT FILE ARGS`` in a session of its own, its output in home/roslaunch.out:
+    on a master of its own (started by roslaunch on a free port), or, given port, on the master
+    running there (roslaunch uses it and leaves it running). :meth:`stop` ends it and everything it
+    started: every process naming home (ROS_HOME and the logs are there), so give each launch a
+    home of its own that no other's path contains."""
+
+    def __init__(
+        self,
+        home,
+        launch_file: str,
+        args: Sequence[str] = (),
+        env: Optional[Dict[str, str]] = None,
+        port: Optional[int] = None,
+    ):
         self.home = str(home)
-        self.port = free_port()
+        self.port = free_port() if port is None else port
         self.env = ros_env(home, self.port, env)
         self.output = os.path.join(self.home, "roslaunch.out")
         self.left: List[str] = []  # what had to be killed when the with-block ended
@@ -196,10 +322,16 @@ class Launch:
 
 
 __all__ = [
+    "CLK_TCK",
     "START",
     "Launch",
+    "Master",
+    "Processes",
     "children",
+    "cmdline",
+    "cpu_seconds",
     "free_port",
+    "group_members",
     "kill_processes_naming",
     "master_is_up",
     "poll",
