@@ -81,14 +81,13 @@ from thorvald_msgs.srv import (
 from . import conversions
 from .bases import create_base_handle, handle_class, handle_class_named, known_handles
 from .bases.handle import DriveTopics, Ports
-from .calibration import load_calibration
 from .core import BaseDriverCore, PoseCovariance
 from .diagnostics import LinkWatch, base_statuses
 from .errors import ParameterError, ThorvaldBaseError
+from .lockstep import LockstepCycles, apply_calibration
 from .node_names import Names, Throttle
 from .params import PARAMETER_NAMES, DriverParams
 from .plugins import load_calculator
-from .rate_grid import RateGrid
 from .stamped_commands import StampedCommands
 
 STATUS_PERIOD = 1.0  # [s] between battery_data / motor_controller_data messages
@@ -254,10 +253,7 @@ class BaseDriverNode:
     def apply_calibration(self, path):
         """The calibration file's values, checked against the robot and applied as set_drive_params
         applies them (the handle built on the robot file keeps its spawn radii: simulated_joints)."""
-        changes = load_calibration(path, self.core.config)
-        _, problems = self.core.set_drive_params(changes)
-        if problems:
-            raise ParameterError(f"~calibration: {path}: " + "; ".join(problems))
+        changes = apply_calibration(self.core, path)
         rospy.loginfo(
             self.label + ": calibration %s: %s",
             path,
@@ -402,21 +398,20 @@ class BaseDriverNode:
         runs (and two robots) cycle at the same instants; what a cycle sees is the states of its
         instant, never an older or a newer one."""
         handle = self.core.handle
-        cycles = RateGrid(self.rate)  # the simulator's ticks are the instants: exact multiples count
+        steps = LockstepCycles(self.core, self.rate)
         last = None
         while not rospy.is_shutdown():
             t = handle.wait_for_states(last, 0.2)
             if t is None:
                 continue
             last = t
-            if cycles.due(t):
+            if steps.due(t):
                 stamp = rospy.Time.from_sec(t)
                 twist = self.stamped_command(t)
                 with self.lock:
                     if self.core.closed:
                         break
-                    refused = self.core.set_command(*twist, t) if twist is not None else None
-                    result = self.core.step(t)
+                    result, refused = steps.cycle(t, twist)
                     if result.odometry.valid:
                         self.covariance.update(result.odometry)
                 if refused:
@@ -426,7 +421,7 @@ class BaseDriverNode:
                 with self.lock:
                     if self.core.closed:
                         break
-                    handle.answer(t)
+                    steps.answer(t)
 
     def publish(self, result, stamp):
         # core.config, not self.config: set_drive_params may have changed r_wheel since start-up

@@ -39,6 +39,8 @@ NOT_PURE = {
     "thorvald_sim.robot": "the simulator's physics (pybullet)",
     "thorvald_sim.simulation": "the simulator's physics (pybullet)",
     "thorvald_sim.sensors": "the simulator's sensors (pybullet)",
+    "thorvald_sim.runner": "drives a robot in the simulator without ROS (pybullet)",
+    "thorvald_sim.run_robot": "the runner's command line (pybullet)",
 }
 # Modules that import ROS only when a function runs, on purpose; every other module (the base
 # handles among them) imports none even inside a function.

@@ -87,6 +87,7 @@ class SimRobot:
             list(as_built.drives) if as_built else [BuiltDrive(d.wheel_radius, 0.0) for d in description.drives]
         )
         self._history = deque()  # (time, drive states) measured, while reports are delayed
+        self._drive_joints = None  # the joints a drive state reads, in one getJointStates call
         self.client = client
         self.name = name
         self.description = description
@@ -266,11 +267,13 @@ class SimRobot:
 
     def _joint_drive_states(self) -> List[MeasuredDrive]:
         """The drives' joints as they are (no encoder, no delay, no homing error)."""
-        c, body = self.client, self.body
+        if self._drive_joints is None:  # every drive's wheel, then its steering if it steers: one call a reading
+            self._drive_joints = [w for w, _, _ in self.wheels] + [s[0] for s in self.steering if s is not None]
+        read = iter(p.getJointStates(self.body, self._drive_joints, physicsClientId=self.client))
+        wheels = [next(read) for _ in self.wheels]
         out = []
-        for (wheel, _, radius), steer in zip(self.wheels, self.steering):
-            w = p.getJointState(body, wheel, physicsClientId=c)
-            s = p.getJointState(body, steer[0], physicsClientId=c) if steer is not None else (0.0, 0.0)
+        for (_, _, radius), steer, w in zip(self.wheels, self.steering, wheels):
+            s = next(read) if steer is not None else (0.0, 0.0)
             out.append(MeasuredDrive(s[0], w[1] * radius, w[0], s[1]))
         return out
 

@@ -1,0 +1,369 @@
+"""Drive a robot in the simulator without ROS: a robot file and a list of commands in, ground truth
+and odometry out.
+
+``rosrun thorvald_sim run_robot ROBOT.yaml --commands CMDS.csv --out DIR`` (:mod:`thorvald_sim.run_robot`)
+and :func:`run_robot` step the simulation of one robot with the robot's own base_driver core in
+the same process: the calculator plugin, the drive layer, the calibration, the limits and the safety
+rules base_driver runs (:class:`thorvald_base.core.BaseDriverCore`), on drives measured from the
+simulated joints (the ``simulated_joints`` base handle, made by base_driver's own factory on ports
+that reach the simulated robot instead of topics). There is no second copy of any of them, nor of
+the timing: the simulator's clock ticks on its grid (``clock_rate``), every tick the drives are
+measured and handed to the handle, and base_driver's lockstep rule
+(:class:`thorvald_base.lockstep.LockstepCycles`) answers it, a control cycle on its own grid or the
+last commands again. It is lockstep by construction, so a run is the same on any machine and under
+any load, and the same as the ROS path (``robot.launch`` in lockstep with stamped commands) to the
+float: times pass through the nanoseconds a ROS stamp keeps, as the ROS path's do.
+
+Commands: ``t, vx, vy, wz`` (base_link: [s], [m/s], [m/s], [rad/s]), each holding from its ``t``
+until the next, the last for ``hold`` seconds more (what base_driver does with a stamped stream,
+:class:`thorvald_base.stamped_commands.StampedCommands`). Before the first, no command: the wheels
+stand.
+
+Outputs (:class:`RunResult`, and with ``out_dir``): ``ground_truth.csv`` and ``odometry.csv``
+(``t,x,y,yaw`` at every control cycle: the simulator's true pose relative to the spawn pose, as
+``odometry/gazebo`` gives it, and base_driver's odometry), and ``summary.json`` (``simulated_s``,
+``wall_s`` (the whole run, ``drive_wall_s`` of it driving: the rest is making the description,
+loading the world, spawning), ``distance_truth_m``, ``distance_odometry_m``,
+``end_point_difference_m``, and what was run). With ``record_sensors``, every sensor of the
+description is measured at its rate and its readings saved under ``sensors/`` (one ``NAME.npz`` a
+sensor: ``t`` and each field of its readings stacked, a lidar's beam directions once; a camera's
+images and depths too).
+
+Not pure: it runs pybullet (a DIRECT client of its own, closed at the end). No ROS master, no rospy.
+"""
+
+import csv
+import json
+import math
+import os
+import time
+from dataclasses import dataclass, field, fields
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+import pybullet as p
+
+from thorvald_base.bases import create_base_handle
+from thorvald_base.bases.handle import Ports
+from thorvald_base.core import BaseDriverCore
+from thorvald_base.lockstep import LockstepCycles, apply_calibration
+from thorvald_base.params import DriverParams
+from thorvald_base.plugins import load_calculator
+from thorvald_base.rate_grid import RateGrid
+from thorvald_base.stamped_commands import StampedCommands
+from thorvald_model import load_robot_config
+from thorvald_model.description import generate_urdf
+from thorvald_model.errors import MISSING, ConfigError, Problem
+
+from .as_built import as_built_for, for_simulator
+from .robot import Pose2D
+from .simulation import Simulation
+from .world import load_world, resolve_world
+
+WHAT = "list of commands"
+ONCE = ("directions",)  # a lidar's beams in its frame: the same every reading
+DERIVED = ("rgba",)  # a camera's renderer output, which its image already holds
+COLUMNS = ("t", "vx", "vy", "wz")
+MAX_COMMANDS = 1_000_000  # rows: a day of commands at 10 Hz
+MAX_DURATION = 86_400.0  # [s] of simulated time a run may ask for
+
+
+@dataclass(frozen=True)
+class TimedTwist:
+    """A command holding from t [s]: vx, vy [m/s] and wz [rad/s] in base_link."""
+
+    t: float
+    vx: float
+    vy: float
+    wz: float
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How a run is made; every default is what ``robot.launch`` in lockstep gives."""
+
+    world: str = "flat"  # a shipped world's name or a world file
+    as_built: str = ""  # an as-built file or PROFILE:SEED (field:7); "": as configured
+    calibration: str = ""  # base_driver's calibration file (calibrate_odometry writes it)
+    model_extras: str = ""  # an extra xacro fitted to the robot (sensors)
+    seed: int = 0  # of every sensor's noise
+    record_sensors: bool = False
+    hold: float = 1.0  # [s] the last command holds
+    robot_name: str = "thorvald_001"
+    tf_prefix: str = "thorvald_001/"
+    x: float = 0.0  # [m] spawn pose
+    y: float = 0.0
+    yaw: float = 0.0  # [rad]
+    physics_rate: float = 240.0  # [Hz], the simulator's
+    clock_rate: float = 80.0  # [Hz], the simulator's ~clock_rate: the instants base_driver answers
+    driver: Dict = field(default_factory=dict)  # base_driver's private parameters (rate, estimator, ...)
+
+
+@dataclass(frozen=True)
+class Sample:
+    t: float  # [s]
+    x: float  # [m]
+    y: float  # [m]
+    yaw: float  # [rad]
+
+
+@dataclass(frozen=True)
+class RunResult:
+    ground_truth: Tuple[Sample, ...]
+    odometry: Tuple[Sample, ...]
+    summary: Dict
+
+
+# ---- commands ------------------------------------------------------------------------------------
+def read_commands(path: str) -> Tuple[TimedTwist, ...]:
+    """A commands file (CSV, a header ``t,vx,vy,wz``), checked: ConfigError naming the file, the line,
+    the value and the rule for every problem."""
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            rows = list(_limited(csv.reader(f), MAX_COMMANDS + 1))
+    except OSError as e:
+        raise ConfigError(path, [Problem("", MISSING, f"cannot read the {WHAT}: {e.strerror}")], WHAT) from None
+    except (UnicodeDecodeError, csv.Error) as e:
+        raise ConfigError(path, [Problem("", MISSING, f"not a CSV text file: {e}")], WHAT) from None
+    return parse_commands(rows, path)
+
+
+def _limited(rows, n):
+    for k, row in enumerate(rows):
+        if k >= n:
+            raise ConfigError(None, [Problem("", MISSING, f"more than {MAX_COMMANDS} commands")], WHAT)
+        yield row
+
+
+def parse_commands(rows: Sequence[Sequence[str]], source: Optional[str] = None) -> Tuple[TimedTwist, ...]:
+    """The commands of a CSV's rows (the first a header naming t, vx, vy, wz in any order)."""
+    rows = [r for r in rows if any(cell.strip() for cell in r)]
+    if not rows:
+        raise ConfigError(source, [Problem("", MISSING, "no header and no command: the file is empty")], WHAT)
+    header = [cell.strip() for cell in rows[0]]
+    missing = [c for c in COLUMNS if c not in header]
+    if missing:
+        rule = f"the header must name the columns {', '.join(COLUMNS)}; missing {', '.join(missing)}"
+        raise ConfigError(source, [Problem("line 1", ",".join(header), rule)], WHAT)
+    where = [header.index(c) for c in COLUMNS]
+    problems, commands = [], []
+    for number, row in enumerate(rows[1:], 2):
+        values = []
+        for column, k in zip(COLUMNS, where):
+            text = row[k].strip() if k < len(row) else ""
+            try:
+                value = float(text)
+            except ValueError:
+                problems.append(Problem(f"line {number}.{column}", text, "must be a number"))
+                continue
+            if not math.isfinite(value):
+                problems.append(Problem(f"line {number}.{column}", text, "must be finite"))
+            values.append(value)
+        if len(values) != len(COLUMNS):
+            continue
+        command = TimedTwist(*values)
+        if not 0.0 <= command.t <= MAX_DURATION:
+            problems.append(Problem(f"line {number}.t", command.t, f"must be in [0, {MAX_DURATION:g}] [s]"))
+        elif commands and command.t <= commands[-1].t:
+            problems.append(
+                Problem(f"line {number}.t", command.t, f"must be after the line before's ({commands[-1].t:g})")
+            )
+        commands.append(command)
+    if not commands and not problems:
+        problems.append(Problem("", MISSING, "no command after the header"))
+    if problems:
+        raise ConfigError(source, problems, WHAT)
+    return tuple(commands)
+
+
+def write_commands(path: str, commands: Sequence[TimedTwist]) -> None:
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        out = csv.writer(f)
+        out.writerow(COLUMNS)
+        out.writerows((repr(c.t), repr(c.vx), repr(c.vy), repr(c.wz)) for c in commands)
+
+
+# ---- the run ----------------------------------------------------------------------------------------
+def stamp_time(t: float) -> float:
+    """t [s] as a ROS stamp carries it: whole nanoseconds, truncated (genpy's Time.from_sec, to_sec)."""
+    secs = int(t)
+    return float(secs) + float(int((t - secs) * 1000000000)) / 1e9
+
+
+class _SimulatedDrives:
+    """The handle's ports to a robot of this process: commands straight to its joints, its measured
+    states handed over each tick (what the simulator's drive_commands and drive_states carry)."""
+
+    def __init__(self, robot):
+        self.robot = robot
+        self.on_states = None
+
+    def send(self, commands, time, drives):
+        self.robot.command(
+            [c.steering for c in commands], [c.speed for c in commands], [d.max_steering_speed for d in drives]
+        )
+
+    def listen(self, on_states):
+        self.on_states = on_states
+
+    def close(self):
+        self.on_states = None
+
+
+class _InProcessPorts(Ports):
+    def __init__(self, drives: _SimulatedDrives):
+        self.drives = drives
+
+    def drive_topics(self, command_topic, state_topic):
+        return self.drives
+
+
+def run_robot(
+    robot_file: str,
+    commands: Sequence[TimedTwist],
+    options: RunOptions = RunOptions(),
+    out_dir: Optional[str] = None,
+) -> RunResult:
+    """Drives the robot of robot_file through commands in a simulation of its own; writes the
+    outputs into out_dir when given. ConfigError for a broken robot, world, as-built, calibration or
+    extras file; RuntimeError when the simulator refuses the robot."""
+    if not commands:
+        raise ValueError("no commands")
+    config = load_robot_config(robot_file)
+    driver = DriverParams.from_dict({**options.driver, "base_handle": "simulated_joints", "lockstep": True})
+    urdf = generate_urdf(
+        robot_file, tf_prefix=options.tf_prefix, model_extras=options.model_extras, robot_name=options.robot_name
+    )
+    as_built = for_simulator(as_built_for(options.as_built, config), config) if options.as_built else None
+    world = load_world(resolve_world(options.world))
+    started = time.monotonic()
+    client = p.connect(p.DIRECT)
+    try:
+        sim = Simulation(client, world, options.physics_rate, seed=options.seed)
+        robot = sim.spawn(options.robot_name, urdf, Pose2D(options.x, options.y, 0.0, options.yaw), as_built)
+        calculator = load_calculator(config, estimator=driver.estimator, projection=driver.projection)
+        drives = _SimulatedDrives(robot)
+        handle = create_base_handle(config, driver, _InProcessPorts(drives))
+        core = BaseDriverCore(config, calculator, handle, command_timeout=driver.command_timeout)
+        if options.calibration:
+            apply_calibration(core, options.calibration)
+        driving = time.monotonic()
+        result = _drive(sim, robot, LockstepCycles(core, driver.rate), drives, commands=commands, options=options)
+        drive_wall = time.monotonic() - driving
+        core.shutdown(sim.time)
+    finally:
+        p.disconnect(client)
+    wall = time.monotonic() - started
+    truth, odometry, recordings = result
+    summary = _summary(truth, odometry, sim_time=truth[-1].t if truth else 0.0, wall=wall)
+    summary.update(
+        drive_wall_s=round(drive_wall, 3),
+        robot=os.path.abspath(robot_file),
+        world=world.source,
+        as_built=options.as_built,
+        calibration=options.calibration,
+        model_extras=options.model_extras,
+        seed=options.seed,
+        commands=len(commands),
+    )
+    run = RunResult(tuple(truth), tuple(odometry), summary)
+    if out_dir is not None:
+        write_outputs(out_dir, run, recordings)
+    return run
+
+
+def _drive(sim, robot, steps, drives, *, commands, options):
+    stamped = StampedCommands()
+    for c in commands:
+        stamped.add(c.t, (c.vx, c.vy, c.wz))
+    end = commands[-1].t + options.hold
+    clock = RateGrid(options.clock_rate, sim.dt)
+    truth, odometry = [], []
+    sensors = list(robot.sensors) if options.record_sensors else []
+    recordings: Dict[str, List] = {s.spec.name: [] for s in sensors}
+    while sim.time < end - 1e-9:
+        sim.step()
+        now = sim.time
+        for sensor in sensors:
+            if sensor.due(now):
+                recordings[sensor.spec.name].append((now, sensor.read(now)))
+        if not clock.due(now):
+            continue
+        t = stamp_time(now)
+        drives.on_states(robot.drive_states(t), t)
+        if not steps.due(t):
+            steps.answer(t)
+            continue
+        twist = stamped.at(t) if stamped.begun(t) else None
+        result, _refused = steps.cycle(t, twist)
+        position, orientation = robot.odom_pose()
+        truth.append(Sample(t, position[0], position[1], _yaw(orientation)))
+        pose = result.odometry.pose
+        odometry.append(Sample(t, pose.x, pose.y, pose.yaw))
+    return truth, odometry, recordings
+
+
+def _yaw(q) -> float:
+    x, y, z, w = q
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def path_length(samples: Sequence[Sample]) -> float:
+    return sum(math.hypot(b.x - a.x, b.y - a.y) for a, b in zip(samples, samples[1:]))
+
+
+def _summary(truth, odometry, sim_time: float, wall: float) -> Dict:
+    end = math.hypot(truth[-1].x - odometry[-1].x, truth[-1].y - odometry[-1].y) if truth else 0.0
+    return {
+        "simulated_s": round(sim_time, 9),
+        "wall_s": round(wall, 3),
+        "distance_truth_m": path_length(truth),
+        "distance_odometry_m": path_length(odometry),
+        "end_point_difference_m": end,
+    }
+
+
+# ---- outputs --------------------------------------------------------------------------------------
+def write_outputs(out_dir: str, run: RunResult, recordings: Optional[Dict[str, List]] = None) -> None:
+    os.makedirs(out_dir, exist_ok=True)
+    for name, samples in (("ground_truth.csv", run.ground_truth), ("odometry.csv", run.odometry)):
+        with open(os.path.join(out_dir, name), "w", newline="", encoding="utf-8") as f:
+            out = csv.writer(f)
+            out.writerow(("t", "x", "y", "yaw"))
+            out.writerows((repr(s.t), repr(s.x), repr(s.y), repr(s.yaw)) for s in samples)
+    with open(os.path.join(out_dir, "summary.json"), "w", encoding="utf-8") as f:
+        json.dump(run.summary, f, indent=2, sort_keys=True)
+        f.write("\n")
+    if recordings:
+        folder = os.path.join(out_dir, "sensors")
+        os.makedirs(folder, exist_ok=True)
+        for name, readings in recordings.items():
+            np.savez_compressed(os.path.join(folder, name + ".npz"), **_arrays(readings))
+
+
+def _arrays(readings) -> Dict[str, np.ndarray]:
+    """A sensor's readings as arrays: t, and each field of its readings stacked (None fields dropped)."""
+    out = {"t": np.array([t for t, _ in readings], dtype=float)}
+    if not readings:
+        return out
+    first = readings[0][1]
+    for name in (f.name for f in fields(first) if getattr(first, f.name) is not None):
+        if name in ONCE:  # the same at every reading: kept once
+            out[name] = np.asarray(getattr(first, name))
+        elif name not in DERIVED:
+            out[name] = np.stack([np.asarray(getattr(r, name)) for _, r in readings])
+    return out
+
+
+__all__ = [
+    "RunOptions",
+    "RunResult",
+    "Sample",
+    "TimedTwist",
+    "parse_commands",
+    "path_length",
+    "read_commands",
+    "run_robot",
+    "stamp_time",
+    "write_commands",
+]
