@@ -11,7 +11,7 @@ motion along or about its axis, as URDF defines them.
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Dict, Iterable, List, Mapping, Optional, Tuple
+from typing import Dict, Iterable, List, Mapping, Optional, Tuple, Union
 
 Vec3 = Tuple[float, float, float]
 Quat = Tuple[float, float, float, float]
@@ -65,12 +65,16 @@ def _triple(text: Optional[str], what: str, default: Vec3 = (0.0, 0.0, 0.0)) -> 
     return values  # type: ignore[return-value]
 
 
-def link_tree(xml: str) -> Dict[str, ParentJoint]:
-    """Each child link's joint to its parent (the root link has none); UrdfError if unreadable."""
-    try:
-        root = ET.fromstring(xml)
-    except ET.ParseError as e:
-        raise UrdfError(f"the robot description is not valid XML: {e}") from None
+def link_tree(xml: Union[str, ET.Element]) -> Dict[str, ParentJoint]:
+    """Each child link's joint to its parent (the root link has none), of a description's text or
+    its parsed ``<robot>``; UrdfError if unreadable."""
+    if isinstance(xml, str):
+        try:
+            root = ET.fromstring(xml)
+        except ET.ParseError as e:
+            raise UrdfError(f"the robot description is not valid XML: {e}") from None
+    else:
+        root = xml
     tree = {}
     for j in root.findall("joint"):
         parent, child = j.find("parent"), j.find("child")

@@ -378,10 +378,7 @@ def urdf_problems(xml: str) -> List[Problem]:
     return _check_tree(root)
 
 
-def checked_urdf(xml: str, source: str) -> str:
-    """The description with its link references normalised, after checking it as check_urdf would;
-    UrdfCheckError listing every problem (source: what to name, e.g. a file or a robot). The text
-    itself when no reference changes."""
+def _checked(xml: str, source: str) -> Tuple[ET.Element, int]:
     if not xml or not xml.strip():
         raise UrdfCheckError(source, urdf_problems(xml))
     try:
@@ -392,12 +389,27 @@ def checked_urdf(xml: str, source: str) -> str:
     problems = _check_tree(root)
     if problems:
         raise UrdfCheckError(source, problems)
+    return root, changed
+
+
+def checked_tree(xml: str, source: str) -> ET.Element:
+    """The description parsed, its link references normalised in place, after checking it as
+    check_urdf would; UrdfCheckError listing every problem (source: what to name, e.g. a file or a
+    robot). For what reads a description once and goes on with the tree (the simulator's spawn)."""
+    return _checked(xml, source)[0]
+
+
+def checked_urdf(xml: str, source: str) -> str:
+    """The description with its link references normalised, after checking it as check_urdf would
+    (:func:`checked_tree`); the text itself when no reference changes."""
+    root, changed = _checked(xml, source)
     return ET.tostring(root, encoding="unicode") if changed else xml
 
 
 __all__ = [
     "JOINT_TYPES",
     "UrdfCheckError",
+    "checked_tree",
     "checked_urdf",
     "closest_names",
     "normalize_document",

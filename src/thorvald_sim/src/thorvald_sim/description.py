@@ -8,6 +8,7 @@ the joint's ``<gazebo reference>`` and the joint's damping) and the passive join
 wheels) with their friction. A URDF without the block (any other robot) is a passive model.
 """
 
+import copy
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -17,9 +18,10 @@ from thorvald_model.datum import Datum, parse_datum
 from thorvald_model.errors import ConfigError
 from thorvald_model.joint_tree import Origin, ParentJoint, UrdfError  # noqa: F401  (Origin: for the sensors)
 from thorvald_model.joint_tree import link_tree as _link_tree
-from thorvald_model.urdf_check import normalize_frame
+from thorvald_model.urdf_check import checked_tree, normalize_frame
 
 from .errors import DescriptionError
+from .sensor_blocks import SensorBlocks, read_sensor_blocks
 
 
 @dataclass(frozen=True)
@@ -91,6 +93,11 @@ def parse_description(xml: str) -> RobotDescription:
         root = ET.fromstring(xml)
     except ET.ParseError as e:
         raise DescriptionError(f"the robot description is not valid XML ({e})") from None
+    return description_of(root)
+
+
+def description_of(root: ET.Element) -> RobotDescription:
+    """The simulator's view of a parsed ``<robot>``; DescriptionError saying why it cannot be used."""
     if root.tag != "robot":
         raise DescriptionError(f"the robot description's root element is <{root.tag}>, not <robot>")
     if root.find("link") is None:
@@ -189,6 +196,12 @@ def with_tyre_contact(xml: str, wheel_joints: Iterable[str], width: float) -> st
     is. The visual shapes, masses and inertias stay as they are.
     """
     root = ET.fromstring(xml)
+    narrow_tyres(root, wheel_joints, width)
+    return ET.tostring(root, encoding="unicode")
+
+
+def narrow_tyres(root: ET.Element, wheel_joints: Iterable[str], width: float) -> None:
+    """:func:`with_tyre_contact` on a parsed ``<robot>``, in place."""
     joints = set(wheel_joints)
     wheel_links = {j.find("child").get("link") for j in root.findall("joint") if j.get("name") in joints}
     for link in root.findall("link"):
@@ -196,7 +209,6 @@ def with_tyre_contact(xml: str, wheel_joints: Iterable[str], width: float) -> st
             continue
         for cylinder in link.findall("collision/geometry/cylinder"):
             cylinder.set("length", repr(min(float(cylinder.get("length")), width)))
-    return ET.tostring(root, encoding="unicode")
 
 
 def with_wheel_radii(xml: str, radii: Mapping[str, float]) -> str:
@@ -206,12 +218,17 @@ def with_wheel_radii(xml: str, radii: Mapping[str, float]) -> str:
     if not radii:
         return xml
     root = ET.fromstring(xml)
+    set_wheel_radii(root, radii)
+    return ET.tostring(root, encoding="unicode")
+
+
+def set_wheel_radii(root: ET.Element, radii: Mapping[str, float]) -> None:
+    """:func:`with_wheel_radii` on a parsed ``<robot>``, in place."""
     links = {j.find("child").get("link"): radii[j.get("name")] for j in root.findall("joint") if j.get("name") in radii}
     for link in root.findall("link"):
         if link.get("name") in links:
             for cylinder in link.findall("collision/geometry/cylinder"):
                 cylinder.set("radius", repr(links[link.get("name")]))
-    return ET.tostring(root, encoding="unicode")
 
 
 @dataclass(frozen=True)
@@ -237,6 +254,12 @@ def resolve_meshes(xml: str, find: MeshFinder) -> Tuple[str, Tuple[MissingMesh, 
     link is drawn and collides with its other geometry; a link left with none keeps its inertial.
     """
     root = ET.fromstring(xml)
+    missing = resolve_meshes_of(root, find)
+    return ET.tostring(root, encoding="unicode"), missing
+
+
+def resolve_meshes_of(root: ET.Element, find: MeshFinder) -> Tuple[MissingMesh, ...]:
+    """:func:`resolve_meshes` on a parsed ``<robot>``, in place; the elements left out."""
     missing = []
     for link in root.findall("link"):
         for kind in ("visual", "collision"):
@@ -251,7 +274,7 @@ def resolve_meshes(xml: str, find: MeshFinder) -> Tuple[str, Tuple[MissingMesh, 
                     missing.append(MissingMesh(link.get("name", ""), kind, uri, reason))
                 else:
                     mesh.set("filename", path)
-    return ET.tostring(root, encoding="unicode"), tuple(missing)
+    return tuple(missing)
 
 
 def mesh_finder(package_path: Callable[[str], Optional[str]]) -> MeshFinder:
@@ -273,3 +296,30 @@ def mesh_finder(package_path: Callable[[str], Optional[str]]) -> MeshFinder:
         return (path, "") if os.path.isfile(path) else (None, "no such file")
 
     return find
+
+
+@dataclass(frozen=True)
+class SpawnedDescription:
+    """A robot description as a spawn reads it, parsed once: every part of the spawn (the robot and
+    its drives, its tyres, its link tree, its sensor blocks) reads this one value, never the text."""
+
+    root: ET.Element  # the <robot>, its link references normalised and checked as check_urdf would
+    robot: RobotDescription
+    links: Dict[str, ParentJoint]  # each child link's joint to its parent
+    sensor_blocks: SensorBlocks
+
+    def for_pybullet(self, find: MeshFinder) -> Tuple[ET.Element, Tuple[MissingMesh, ...]]:
+        """A copy of the tree for pybullet to load, its meshes found (the elements left out, too)."""
+        root = copy.deepcopy(self.root)
+        return root, resolve_meshes_of(root, find)
+
+
+def spawned_description(xml: str, source: str) -> SpawnedDescription:
+    """The description parsed once, normalised and checked (UrdfCheckError naming source and every
+    problem), read by the simulator (DescriptionError saying why it cannot be used)."""
+    root = checked_tree(xml, source)
+    try:
+        links = _link_tree(root)
+    except UrdfError as e:
+        raise DescriptionError(str(e)) from None
+    return SpawnedDescription(root, description_of(root), links, read_sensor_blocks(root))

@@ -34,16 +34,24 @@ import math
 import os
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 from collections import deque
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple, Union
 
 import pybullet as p
 
 from thorvald_base.bases import MeasuredDrive
 
 from .as_built import BuiltDrive, SimAsBuilt
-from .description import DescriptionError, RobotDescription, with_tyre_contact, with_wheel_radii
+from .description import (
+    DescriptionError,
+    RobotDescription,
+    narrow_tyres,
+    set_wheel_radii,
+    with_tyre_contact,
+    with_wheel_radii,
+)
 
 LOAD_FLAGS = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER | p.URDF_MERGE_FIXED_LINKS
 LINK_FRICTION = 1.0
@@ -72,7 +80,7 @@ class SimRobot:
         client: int,
         name: str,
         description: RobotDescription,
-        urdf: str,
+        urdf: Union[str, ET.Element],
         pose: Pose2D,
         *,
         tyre_contact_width: float = TYRE_CONTACT_WIDTH,
@@ -101,8 +109,14 @@ class SimRobot:
         radii = {
             d.wheel_joint: b.r_wheel for d, b in zip(description.drives, self.built) if b.r_wheel != d.wheel_radius
         }
+        if isinstance(urdf, str):
+            text = with_tyre_contact(with_wheel_radii(urdf, radii), wheels, tyre_contact_width)
+        else:  # a parsed <robot> of the robot's own (SpawnedDescription.for_pybullet): changed in place
+            set_wheel_radii(urdf, radii)
+            narrow_tyres(urdf, wheels, tyre_contact_width)
+            text = ET.tostring(urdf, encoding="unicode")
         with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
-            f.write(with_tyre_contact(with_wheel_radii(urdf, radii), wheels, tyre_contact_width))
+            f.write(text)
         try:
             orientation = p.getQuaternionFromEuler((0.0, 0.0, pose.yaw))
             with quiet_stdout():
@@ -269,6 +283,8 @@ class SimRobot:
         """The drives' joints as they are (no encoder, no delay, no homing error)."""
         if self._drive_joints is None:  # every drive's wheel, then its steering if it steers: one call a reading
             self._drive_joints = [w for w, _, _ in self.wheels] + [s[0] for s in self.steering if s is not None]
+        if not self._drive_joints:  # a passive model: pybullet reads no joints as None
+            return []
         read = iter(p.getJointStates(self.body, self._drive_joints, physicsClientId=self.client))
         wheels = [next(read) for _ in self.wheels]
         out = []

@@ -61,7 +61,7 @@ Topic and frame names stay as the block writes them; :func:`resolve_topic` and
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, replace
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, List, Optional, Tuple, Union
 
 from thorvald_model.datum import Datum
 from thorvald_model.joint_tree import Origin as Pose  # a transform: SDF's <pose> is URDF's <origin>
@@ -645,9 +645,10 @@ KNOWN_MODEL_PLUGINS = ("libthorvald_gazebo_plugins_synch.so", "libthorvald_gazeb
 # ---------------------------------------------------------------------------------------------
 # The description
 # ---------------------------------------------------------------------------------------------
-def read_sensor_blocks(xml: str) -> SensorBlocks:
-    """Every sensor of a robot description (a URDF string); never raises for a sensor's fault."""
-    root = ET.fromstring(xml)
+def read_sensor_blocks(xml: Union[str, ET.Element]) -> SensorBlocks:
+    """Every sensor of a robot description (a URDF string, or its parsed ``<robot>``); never raises
+    for a sensor's fault."""
+    root = ET.fromstring(xml) if isinstance(xml, str) else xml
     links = [link.get("name", "") for link in root.findall("link")]
     children = {j.find("child").get("link") for j in root.findall("joint") if j.find("child") is not None}
     root_link = next((link for link in links if link not in children), links[0] if links else "")

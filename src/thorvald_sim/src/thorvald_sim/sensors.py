@@ -41,7 +41,7 @@ import operator
 import re
 import zlib
 from dataclasses import dataclass
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import pybullet as p
@@ -531,11 +531,18 @@ class MountProblem:
 
 
 def build_sensors(
-    specs, robot, urdf: str, *, seed: int = 0, dt: float, gravity: float = 9.81, datum: Optional[Datum] = None
+    specs,
+    robot,
+    links: Union[str, Dict[str, ParentJoint]],
+    *,
+    seed: int = 0,
+    dt: float,
+    gravity: float = 9.81,
+    datum: Optional[Datum] = None,
 ) -> Tuple[List[Sensor], List[MountProblem]]:
-    """The robot's sensors from its specs; (sensors, problems) where a problem names a sensor whose
-    link cannot be mounted (the others are kept)."""
-    tree = link_tree(urdf)
+    """The robot's sensors from its specs and its link tree (or its description's text, parsed for it);
+    (sensors, problems) where a problem names a sensor whose link cannot be mounted (the others are kept)."""
+    tree = link_tree(links) if isinstance(links, str) else links
     sensors, problems = [], []
     for spec in specs:
         try:

@@ -11,14 +11,14 @@ from typing import Dict, Optional, Tuple
 import numpy as np
 import pybullet as p
 
-from thorvald_model.urdf_check import UrdfCheckError, checked_urdf
+from thorvald_model.urdf_check import UrdfCheckError
 
 from .as_built import SimAsBuilt
-from .description import DescriptionError, MeshFinder, mesh_finder, parse_description, resolve_meshes
+from .description import DescriptionError, MeshFinder, mesh_finder, spawned_description
 from .errors import SpawnError
 from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
 from .scene import build_scene
-from .sensor_blocks import Datum, read_sensor_blocks
+from .sensor_blocks import Datum
 from .sensors import build_sensors
 from .world import WorldConfig
 
@@ -100,17 +100,19 @@ class Simulation:
         if name in self.robots:
             raise SpawnError(f"a robot named {name!r} exists already")
         try:
-            urdf = checked_urdf(urdf, name)
+            spawned = spawned_description(urdf, name)  # parsed once: everything below reads this
         except UrdfCheckError as e:
             raise SpawnError(str(e)) from None  # "NAME: invalid robot description (...)", each line naming NAME
+        except DescriptionError as e:
+            raise SpawnError(f"{name}: {e}") from None
+        description = spawned.robot
         try:
-            description = parse_description(urdf)
-            urdf, missing = resolve_meshes(urdf, self.find_mesh)
+            tree, missing = spawned.for_pybullet(self.find_mesh)
             robot = SimRobot(
                 self.client,
                 name,
                 description,
-                urdf,
+                tree,
                 pose,
                 tyre_contact_width=self.tyre_contact_width,
                 as_built=as_built,
@@ -118,12 +120,11 @@ class Simulation:
         except DescriptionError as e:
             raise SpawnError(f"{name}: {e}") from None
         robot.missing_meshes = missing
-        blocks = read_sensor_blocks(urdf)
-        robot.sensor_blocks = blocks
+        robot.sensor_blocks = spawned.sensor_blocks
         robot.sensors, robot.sensor_problems = build_sensors(
-            blocks.sensors,
+            spawned.sensor_blocks.sensors,
             robot,
-            urdf,
+            spawned.links,
             seed=self.seed,
             dt=self.dt,
             gravity=self.world.gravity,
