@@ -245,7 +245,9 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated seconds measured per case")
     parser.add_argument("--robots", type=int, nargs="+", default=[1, 4, 9])
-    parser.add_argument("--clock-rate", type=float, default=80.0, help="the simulator's ~clock_rate [Hz] (80, its default)")
+    parser.add_argument(
+        "--clock-rate", type=float, default=80.0, help="the simulator's ~clock_rate [Hz] (80, its default)"
+    )
     args = parser.parse_args()
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # the master and launches are stopped on the way out
     print(
