@@ -1,7 +1,10 @@
-"""What the simulator's unit tests share: a pybullet client, a ray straight down, a world's problems.
+"""What the simulator's unit tests share: a pybullet client, a ray straight down, a world's problems,
+a publisher that records what a sensor publishes.
 
 A unique module name, so the conftest.py files of several packages never shadow each other in one
 pytest run (conftest.py imports the fixture from here)."""
+
+import io
 
 import pybullet as p
 import pytest
@@ -29,3 +32,22 @@ def world_problems(data, source="test-world", base_dir=None):
     with pytest.raises(ConfigError) as e:
         parse_world(data, source, base_dir)
     return {pr.path: pr for pr in e.value.problems}
+
+
+class Recorder:
+    """A publisher every topic is subscribed to: each message serialised as rospy would, and kept."""
+
+    def __init__(self, topic, msg_type):
+        self.topic, self.type = topic, msg_type
+        self.messages = []
+
+    def get_num_connections(self) -> int:
+        return 1
+
+    def publish(self, msg) -> None:
+        buff = io.BytesIO()
+        msg.serialize(buff)
+        self.messages.append(self.type().deserialize(buff.getvalue()))
+
+    def unregister(self) -> None:
+        pass

@@ -9,7 +9,6 @@ client, measured through RobotSensors as the simulator node does; its publisher 
 every topic is subscribed to and that serialises each message as rospy would.
 """
 
-import io
 import logging
 import math
 from dataclasses import replace
@@ -18,6 +17,7 @@ import numpy as np
 import pybullet as p
 import pytest
 from sensor_msgs.msg import LaserScan
+from sim_test_helpers import Recorder
 
 from thorvald_sim.robot import Pose2D
 from thorvald_sim.sensor_blocks import MAX_RAYS
@@ -57,25 +57,6 @@ def robot_urdf(*blocks: str) -> str:
     <child link="camera_link"/></joint>
   {"".join(blocks)}
 </robot>"""
-
-
-class Recorder:
-    """A publisher every topic is subscribed to: each message serialised as rospy would, and kept."""
-
-    def __init__(self, topic, msg_type):
-        self.topic, self.type = topic, msg_type
-        self.messages = []
-
-    def get_num_connections(self) -> int:
-        return 1
-
-    def publish(self, msg) -> None:
-        buff = io.BytesIO()
-        msg.serialize(buff)
-        self.messages.append(self.type().deserialize(buff.getvalue()))
-
-    def unregister(self) -> None:
-        pass
 
 
 @pytest.fixture

@@ -11,7 +11,7 @@ import numpy as np
 import pybullet as p
 import pytest
 
-import thorvald_sim.sensors as sensors_module
+import thorvald_sim.sensor_kinds.lidar as lidar_module
 from thorvald_sim.robot import Pose2D
 from thorvald_sim.sensor_blocks import Datum
 from thorvald_sim.sensors import (
@@ -409,7 +409,7 @@ def test_the_sensor_report_names_a_sensor_that_cannot_hold_its_rate():
 
 def test_the_lidar_arithmetic_is_built_in_c():
     # catkin_make builds csrc/scan.c (tools/setup installs Python's headers); numpy is only the fallback
-    assert sensors_module._scan is not None
+    assert lidar_module._scan is not None
 
 
 def test_the_compiled_beams_and_ranges_are_numpys():

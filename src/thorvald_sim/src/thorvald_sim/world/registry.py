@@ -15,6 +15,7 @@ from typing import Iterator, List, Optional, Sequence, Tuple
 
 from thorvald_model.schema import KIND_NAMES, REQUIRED, Key
 
+from ..doc_tables import markers, with_table
 from .budgets import bodies_each, patches_budget, polytunnels_budget, rows_budget, walls_budget
 from .elements import (
     _height_field,
@@ -203,19 +204,14 @@ def keys_markdown(kinds: Optional[Sequence[ElementKind]] = None) -> str:
     return "\n".join(lines) + "\n"
 
 
-KEYS_BEGIN = "<!-- world-keys:begin -->"  # the lines around the table in a markdown file (docs/worlds.md)
-KEYS_END = "<!-- world-keys:end -->"
+KEYS_TABLE = "world-keys"  # the name of its marker lines in a markdown file (docs/worlds.md)
+KEYS_BEGIN, KEYS_END = markers(KEYS_TABLE)
 
 
 def with_keys_table(text: str, table: str) -> str:
     """The markdown text with the lines between its KEYS_BEGIN and KEYS_END lines replaced by table;
     ValueError if it has not both, in that order, once each."""
-    lines = text.splitlines(keepends=True)
-    marks = [i for i, line in enumerate(lines) if line.strip() in (KEYS_BEGIN, KEYS_END)]
-    if [lines[i].strip() for i in marks] != [KEYS_BEGIN, KEYS_END]:
-        raise ValueError(f"needs the lines {KEYS_BEGIN} and {KEYS_END}, once each and in that order")
-    begin, end = marks
-    return "".join(lines[: begin + 1]) + table + "".join(lines[end:])
+    return with_table(text, table, KEYS_TABLE)
 
 
 def _keys_text(keys: Sequence[Key], defaults) -> str:
