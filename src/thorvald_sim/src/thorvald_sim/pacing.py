@@ -14,7 +14,7 @@ so tests drive it with a clock of their own.
 
 import math
 import time
-from typing import Callable, Optional, Tuple
+from typing import Callable, List, Optional, Tuple
 
 CATCH_UP = 0.05  # [s] of wall time behind the pace after which the pace starts again from now
 
@@ -58,3 +58,43 @@ class Pacer:
     def paused(self) -> None:
         """The simulation is paused: the pace starts again from the first step after it."""
         self.anchor = None
+
+
+MAX_WAIT = 0.5  # [s] wall: the longest a simulation waits at once for robots that lag
+
+
+class FollowerWait:
+    """Holds a simulation (without lockstep) while robots' commands lag behind simulated time, for at
+    most max_wait [s] of wall time at once: a busy machine slows the simulation instead of letting
+    robots drive on stale commands, and a robot that cannot keep up does not stop it for long."""
+
+    def __init__(
+        self,
+        max_wait: float = MAX_WAIT,
+        clock: Callable[[], float] = time.monotonic,
+        sleep: Callable[[float], None] = time.sleep,
+        poll: float = 0.0005,
+    ):
+        self.max_wait = max_wait
+        self.clock = clock
+        self.sleep = sleep
+        self.poll = poll
+
+    def wait(
+        self, lagging: Callable[[], List[str]], first: Callable[[], None], stop: Callable[[], bool] = lambda: False
+    ) -> List[str]:
+        """Waits while lagging() names robots; first() is called once when the wait begins (the lagging
+        drivers run on the clock it publishes). Returns the robots given up on after max_wait ([] when
+        none lag any more, or stop() said so)."""
+        deadline = None
+        while not stop():
+            names = lagging()
+            if not names:
+                return []
+            if deadline is None:
+                first()
+                deadline = self.clock() + self.max_wait
+            elif self.clock() > deadline:
+                return names
+            self.sleep(self.poll)
+        return []

@@ -221,3 +221,32 @@ class PerformanceMeter:
             return None
         start, self._start = self._start, now
         return Performance(*(b - a for a, b in zip(start, now)))
+
+
+def performance_report(
+    perf: Performance, *, robots: int, asked: float, paused: bool, physics_rate: float, simulated_now: float
+) -> Tuple[int, str, Dict[str, str]]:
+    """(level, message, values) of the simulator's /diagnostics for a window: the real-time factor
+    reached, and the process's CPU time per simulated second, all of it and pybullet's solver's part (the
+    rest is ROS and Python: messages in and out, the loop). A warning (level 1) when a real-time factor
+    asked for is not held (below 90 %); asked 0: as fast as possible."""
+    rtf = perf.real_time_factor
+    level = 0
+    if paused:
+        message = "paused"
+    else:
+        message = f"{robots} robot{'' if robots == 1 else 's'}, {rtf:.2f} x real time"
+        if asked and rtf < 0.9 * asked:
+            level = 1
+            message += f" (asked for {asked:g} x: the machine cannot keep up)"
+    values = {
+        "robots": str(robots),
+        "simulated time [s]": f"{simulated_now:.3f}",
+        "real-time factor": f"{rtf:.3f}",
+        "real-time factor asked": f"{asked:g}" if asked else "as fast as possible",
+        "physics rate [Hz]": f"{physics_rate:g}",
+        "CPU per simulated second [s]": f"{perf.per_simulated_second(perf.cpu):.5f}",
+        "solver CPU per simulated second [s]": f"{perf.per_simulated_second(perf.solver_cpu):.5f}",
+        "CPU share [cores]": f"{perf.cpu / perf.wall:.3f}",
+    }
+    return level, message, values

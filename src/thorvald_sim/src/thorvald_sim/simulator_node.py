@@ -2,9 +2,11 @@
 
 The node is wiring: the world and its robots are :class:`thorvald_sim.simulation.Simulation`; the
 loop's parts are pure modules tested with a clock of their own: the parameters read once
-(:mod:`thorvald_sim.params`), real-time pacing (:mod:`thorvald_sim.pacing`), lockstep
-(:mod:`thorvald_sim.lockstep`) and the grid of simulated time every periodic message falls on
-(:mod:`thorvald_base.rate_grid`, the sensors' and base_driver's too).
+(:mod:`thorvald_sim.params`), real-time pacing and the wait for robots that lag
+(:mod:`thorvald_sim.pacing`), lockstep (:mod:`thorvald_sim.lockstep`), each robot's commands
+(:mod:`thorvald_sim.commands`), the grid of simulated time every periodic message falls on
+(:mod:`thorvald_base.rate_grid`, the sensors' and base_driver's too) and the performance report
+(:func:`thorvald_sim.simulation.performance_report`).
 
 Private parameters:
 
@@ -85,7 +87,7 @@ import time
 import pybullet as p
 import rosgraph
 import rospy
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from diagnostic_msgs.msg import DiagnosticArray
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -108,20 +110,19 @@ from thorvald_msgs.srv import (
 )
 
 from .as_built import SimAsBuilt
+from .commands import APPLY, HOLD, CommandSlot
 from .errors import ParameterError, SpawnError
 from .lockstep import Lockstep
-from .pacing import Pacer
+from .pacing import FollowerWait, Pacer
 from .params import SimulatorParams
 from .robot import Pose2D
 from .sensor_io import RobotSensors
 from .sensors import disabled_report, refused_sensors, sensor_report
-from .simulation import Camera, PerformanceMeter, Simulation, save_png
+from .simulation import Camera, PerformanceMeter, Simulation, performance_report, save_png
 from .tf_watch import TfWatch
 from .world import load_world, resolve_world
 
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
-MAX_WAIT = 0.5  # [s] wall: the longest the simulator waits at once for a lagging robot
-STREAM_ALIVE = 1.0  # [s] wall: a robot whose commands stopped this long ago is not waited for
 EXIT_REFUSED = 1
 TF_POLL = 2.0  # [s] wall: how often the master is asked who publishes /tf (another odom -> base_link)
 
@@ -138,12 +139,7 @@ class RobotIO:
         self.odom_pub = NonBlockingPublisher(ns + d.odometry_topic, Odometry)
         self.joint_pub = NonBlockingPublisher(ns + "joint_states", JointState)
         self.drive_pub = NonBlockingPublisher(ns + "drive_states", BaseState)
-        self.lock = threading.Lock()
-        self.command = None  # the latest (steering, speeds, max steering speeds), to apply in the loop
-        self.command_time = None  # [s] simulated time it arrived
-        self.command_stamp = None  # [s] simulated time the command is for (its stamp)
-        self.command_wall = None  # [s] wall (monotonic) time it arrived
-        self.fresh = False
+        self.commands = CommandSlot(len(robot.wheels))  # the latest, to apply in the loop
         self.node = node
         self.sub = rospy.Subscriber(ns + command_topic, BaseState, self.on_command, queue_size=1)
         self.passive = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
@@ -153,50 +149,21 @@ class RobotIO:
         )
 
     def on_command(self, msg):
-        n = len(self.robot.wheels)
-        if len(msg.steer_pos) != n or len(msg.prop_speed) != n:
-            rospy.logwarn_throttle(
-                WARN_PERIOD,
-                "simulator: %s: a command for %d/%d drives ignored; the robot has %d",
-                self.robot.name,
-                len(msg.steer_pos),
-                len(msg.prop_speed),
-                n,
-            )
-            return
-        values = list(msg.steer_pos) + list(msg.prop_speed) + list(msg.steer_max_speed)
-        if not all(math.isfinite(v) for v in values):
-            rospy.logwarn_throttle(WARN_PERIOD, "simulator: %s: a non-finite command ignored", self.robot.name)
-            return
-        limits = list(msg.steer_max_speed) if len(msg.steer_max_speed) == n else None
         stamp = msg.header.stamp.to_sec()
-        with self.lock:
-            self.command = (list(msg.steer_pos), list(msg.prop_speed), limits)
-            self.command_time = self.node.sim.time
-            self.command_stamp = stamp
-            self.command_wall = time.monotonic()
-            self.fresh = True
+        problem = self.commands.put(msg.steer_pos, msg.prop_speed, msg.steer_max_speed, self.node.sim.time, stamp)
+        if problem:
+            rospy.logwarn_throttle(WARN_PERIOD, "simulator: %s: %s", self.robot.name, problem)
+            return
         if self.node.lockstep and self.node.waits.answered(self.robot.name, stamp):
             rospy.loginfo("simulator: %s in lockstep", self.robot.name)
 
-    def lagging(self, now: float, max_lag: float) -> bool:
-        """Whether this robot's command stream is alive but more than max_lag [s] behind simulated time."""
-        with self.lock:
-            stamp, wall = self.command_stamp, self.command_wall
-        return stamp is not None and time.monotonic() - wall < STREAM_ALIVE and now - stamp > max_lag
-
     def apply(self, now: float, timeout: float) -> None:
         """In the loop, before a step: the latest command, or a stop if commands stopped coming."""
-        with self.lock:
-            command, fresh, since = self.command, self.fresh, self.command_time
-            self.fresh = False
-        if fresh:
+        action, command = self.commands.take(now, timeout)
+        if action == APPLY:
             self.robot.command(*command)
-        elif since is not None and now - since > timeout:
+        elif action == HOLD:
             self.robot.hold()
-            with self.lock:
-                if self.command_time == since:
-                    self.command_time = None
 
     def publish_odometry(self, stamp, tf_read: bool):
         """odometry/gazebo, joint_states of the passive joints: only what somebody reads; the transform of
@@ -256,6 +223,7 @@ class SimulatorNode:
         self.lockstep = params.lockstep
         self.waits = Lockstep()  # lockstep: which robots the world waits for, for which instant
         self.pacer = Pacer(params.real_time_factor)
+        self.followers = FollowerWait()  # without lockstep: robots whose commands lag ~max_lag behind
         self.client = p.connect(p.GUI if self.gui else p.DIRECT)
         self.sim = Simulation(
             self.client, world, params.physics_rate, params.tyre_contact_width, seed=params.seed, datum=datum
@@ -453,29 +421,23 @@ class SimulatorNode:
             )
 
     def wait_for_followers(self):
-        """Holds the world while a robot's commands lag more than ~max_lag behind (at most MAX_WAIT)."""
+        """Holds the world while a robot's commands lag more than ~max_lag behind (see FollowerWait)."""
         if self.max_lag <= 0 or self.lockstep:
             return
-        deadline = None
-        while not rospy.is_shutdown():
+
+        def lagging():
             with self.lock:
                 now = self.sim.time
-                lagging = [io for io in self.io.values() if io.lagging(now, self.max_lag)]
-                if lagging and deadline is None:
-                    self.publish_clock()  # the lagging nodes run on it
-            if not lagging:
-                return
-            if deadline is None:
-                deadline = time.monotonic() + MAX_WAIT
-            elif time.monotonic() > deadline:
-                rospy.logwarn_throttle(
-                    WARN_PERIOD,
-                    "simulator: %s lag more than %.2f s behind simulated time; going on without them",
-                    ", ".join(io.robot.name for io in lagging),
-                    self.max_lag,
-                )
-                return
-            time.sleep(0.0005)
+                return [name for name, io in self.io.items() if io.commands.lagging(now, self.max_lag)]
+
+        given_up = self.followers.wait(lagging, self.publish_clock, rospy.is_shutdown)
+        if given_up:
+            rospy.logwarn_throttle(
+                WARN_PERIOD,
+                "simulator: %s lag more than %.2f s behind simulated time; going on without them",
+                ", ".join(given_up),
+                self.max_lag,
+            )
 
     def publish(self, now: float) -> bool:
         """What is due at simulated time now; whether /clock ticked. In lockstep the drive states go
@@ -560,10 +522,9 @@ class SimulatorNode:
             )
 
     def publish_performance(self, wall: float) -> None:
-        """/diagnostics once per ~diagnostics_rate period of wall time: the real-time factor reached, and
-        the process's CPU time per simulated second, all of it and pybullet's solver's part (the rest is
-        ROS and Python: messages in and out, the loop). A warning when a real-time factor asked for is
-        not held (below 90 %)."""
+        """/diagnostics once per ~diagnostics_rate period of wall time: the simulation's
+        (:func:`thorvald_sim.simulation.performance_report`), each robot's sensors' and each sensor a
+        robot goes without."""
         if not self.meter.due(wall):
             return
         perf = self.meter.sample(wall, self.sim.time, time.process_time(), self.sim.solver_cpu)
@@ -579,29 +540,11 @@ class SimulatorNode:
             disabled = [(name, sensor) for name, io in self.io.items() for sensor in io.sensors.disabled()]
         if not self.diagnostics.get_num_connections():
             return
-        rtf = perf.real_time_factor
-        level = DiagnosticStatus.OK
-        if self.paused:
-            message = "paused"
-        else:
-            n = len(self.io)
-            message = f"{n} robot{'' if n == 1 else 's'}, {rtf:.2f} x real time"
-            if asked and rtf < 0.9 * asked:
-                level = DiagnosticStatus.WARN
-                message += f" (asked for {asked:g} x: the machine cannot keep up)"
-        values = {
-            "robots": len(self.io),
-            "simulated time [s]": f"{self.sim.time:.3f}",
-            "real-time factor": f"{rtf:.3f}",
-            "real-time factor asked": f"{asked:g}" if asked else "as fast as possible",
-            "physics rate [Hz]": f"{1.0 / self.sim.dt:g}",
-            "CPU per simulated second [s]": f"{perf.per_simulated_second(perf.cpu):.5f}",
-            "solver CPU per simulated second [s]": f"{perf.per_simulated_second(perf.solver_cpu):.5f}",
-            "CPU share [cores]": f"{perf.cpu / perf.wall:.3f}",
-        }
-        statuses = [
-            conversions.diagnostic_status(rospy.get_name() + ": simulation", "pybullet", level, message, values)
-        ]
+        simulation = performance_report(
+            perf, robots=len(self.io), asked=asked, paused=self.paused, physics_rate=1.0 / self.sim.dt,
+            simulated_now=self.sim.time,
+        )  # fmt: skip
+        statuses = [conversions.diagnostic_status(rospy.get_name() + ": simulation", "pybullet", *simulation)]
         statuses += [
             conversions.diagnostic_status(f"{rospy.get_name()}: sensors of {name}", name, *report)
             for name, report in sensor_reports

@@ -1,12 +1,14 @@
-"""The simulation loop's pure parts with a clock of the test's own: pacing, lockstep, parameters."""
+"""The simulation loop's pure parts with a clock of the test's own: pacing, lockstep, parameters, the
+robots' commands and the wait for robots that lag."""
 
 import threading
 
 import pytest
 
+from thorvald_sim.commands import APPLY, HOLD, STREAM_ALIVE, CommandSlot
 from thorvald_sim.errors import ParameterError, ThorvaldSimError
 from thorvald_sim.lockstep import Lockstep
-from thorvald_sim.pacing import Pacer
+from thorvald_sim.pacing import FollowerWait, Pacer
 from thorvald_sim.params import SimulatorParams
 
 
@@ -177,3 +179,62 @@ def test_a_bad_parameter_is_refused_with_its_name_value_and_rule(name, value, ru
         SimulatorParams.read(lambda n, d: value if n == name else d)
     assert str(e.value).startswith(f"~{name}: {value!r}: {rule}")
     assert isinstance(e.value, ThorvaldSimError)
+
+
+# ---- commands ------------------------------------------------------------------------------------
+def test_each_command_is_applied_once_and_a_silent_robot_is_held_once():
+    slot = CommandSlot(2, clock=FakeClock())
+    assert slot.take(0.0, 0.5) == (None, None)  # nothing came yet: nothing to do, no hold
+    assert slot.put([0.1, 0.2], [1.0, 1.0], [], now=1.0, stamp=1.0) == ""
+    assert slot.take(1.0, 0.5) == (APPLY, ([0.1, 0.2], [1.0, 1.0], None))
+    assert slot.take(1.2, 0.5) == (None, None)  # applied already; not stale yet
+    assert slot.take(1.6, 0.5) == (HOLD, None)  # 0.6 s without a command: the wheels stop, once
+    assert slot.take(5.0, 0.5) == (None, None)
+    slot.put([0.0, 0.0], [0.5, 0.5], [1.0, 2.0], now=5.0, stamp=5.0)
+    assert slot.take(5.0, 0.5) == (APPLY, ([0.0, 0.0], [0.5, 0.5], [1.0, 2.0]))
+
+
+@pytest.mark.parametrize(
+    ("steering", "speeds", "limits", "says"),
+    [
+        ([0.0], [1.0, 1.0], [], "a command for 1/2 drives ignored; the robot has 2"),
+        ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [], "a command for 3/3 drives ignored; the robot has 2"),
+        ([0.0, float("nan")], [1.0, 1.0], [], "a non-finite command ignored"),
+        ([0.0, 0.0], [1.0, float("inf")], [], "a non-finite command ignored"),
+        ([0.0, 0.0], [1.0, 1.0], [float("nan"), 1.0], "a non-finite command ignored"),
+    ],
+)
+def test_a_command_that_cannot_be_applied_is_refused_and_the_last_one_stays(steering, speeds, limits, says):
+    slot = CommandSlot(2, clock=FakeClock())
+    slot.put([0.1, 0.1], [1.0, 1.0], [], now=1.0, stamp=1.0)
+    assert slot.put(steering, speeds, limits, now=1.1, stamp=1.1) == says
+    assert slot.take(1.1, 0.5) == (APPLY, ([0.1, 0.1], [1.0, 1.0], None))
+
+
+def test_a_robot_lags_while_its_stream_is_alive_and_behind():
+    clock = FakeClock()
+    slot = CommandSlot(1, clock=clock)
+    assert not slot.lagging(10.0, 0.05)  # no command yet: nothing to wait for
+    slot.put([0.0], [1.0], [], now=10.0, stamp=9.99)
+    assert not slot.lagging(10.0, 0.05)  # 10 ms behind
+    assert slot.lagging(10.1, 0.05)  # 110 ms behind, its last command just now
+    clock.now += STREAM_ALIVE + 0.01
+    assert not slot.lagging(10.1, 0.05)  # its stream stopped: not waited for
+
+
+def test_the_wait_for_lagging_robots_ends_when_they_catch_up():
+    clock = FakeClock()
+    behind = iter([["r1", "r2"], ["r1"], ["r1"], []])
+    ticks = []
+    wait = FollowerWait(max_wait=0.5, clock=clock, sleep=clock.sleep, poll=0.001)
+    assert wait.wait(lambda: next(behind), lambda: ticks.append(clock.now)) == []
+    assert ticks == [100.0] and clock.slept == [0.001] * 3  # the clock published once, at the start
+
+
+def test_a_robot_that_cannot_catch_up_is_given_up_on_after_the_longest_wait():
+    clock = FakeClock()
+    wait = FollowerWait(max_wait=0.5, clock=clock, sleep=clock.sleep, poll=0.001)
+    assert wait.wait(lambda: ["slow"], lambda: None) == ["slow"]
+    assert clock.now - 100.0 == pytest.approx(0.501, abs=0.0015)
+    assert wait.wait(lambda: [], lambda: None) == []  # nobody lags: no wait at all
+    assert wait.wait(lambda: ["slow"], lambda: None, stop=lambda: True) == []  # shutting down

@@ -6,7 +6,7 @@ import time
 import pybullet as p
 import pytest
 
-from thorvald_sim.simulation import Performance, PerformanceMeter, Simulation
+from thorvald_sim.simulation import Performance, PerformanceMeter, Simulation, performance_report
 from thorvald_sim.world import parse_world
 
 
@@ -52,3 +52,24 @@ def test_the_simulation_counts_the_cpu_its_solver_takes():
         assert sim.solver_cpu > 0.5 * cpu
     finally:
         p.disconnect(client)
+
+
+def test_the_report_warns_when_the_factor_asked_is_not_held():
+    perf = Performance(wall=2.0, simulated=1.6, cpu=1.0, solver_cpu=0.4)
+    level, message, values = performance_report(
+        perf, robots=3, asked=1.0, paused=False, physics_rate=240.0, simulated_now=12.5
+    )
+    assert (level, message) == (1, "3 robots, 0.80 x real time (asked for 1 x: the machine cannot keep up)")
+    assert values["CPU per simulated second [s]"] == "0.62500" and values["CPU share [cores]"] == "0.500"
+    assert values["solver CPU per simulated second [s]"] == "0.25000" and values["simulated time [s]"] == "12.500"
+    # 0.8 holds half of real time; as fast as possible holds any; paused says so
+    assert performance_report(perf, robots=1, asked=0.5, paused=False, physics_rate=240.0, simulated_now=0.0)[:2] == (
+        0,
+        "1 robot, 0.80 x real time",
+    )
+    fast = performance_report(perf, robots=1, asked=0.0, paused=False, physics_rate=240.0, simulated_now=0.0)
+    assert fast[0] == 0 and fast[2]["real-time factor asked"] == "as fast as possible"
+    assert performance_report(perf, robots=1, asked=1.0, paused=True, physics_rate=240.0, simulated_now=0.0)[:2] == (
+        0,
+        "paused",
+    )
