@@ -8,26 +8,19 @@ table row per world. Invalid files: every problem, one per line, on stderr, and 
 """
 
 import argparse
-import math
 import sys
 from typing import List, Optional, Tuple
 
 from thorvald_model.check_report import report
 
-from .world import ConfigError, WorldConfig, load_world, plant_positions, resolve_world
+from .world import ConfigError, WorldConfig, element_kinds, load_world, plant_positions, resolve_world
 
 Box = Tuple[float, float, float, float]  # (x min, y min, x max, y max) [m]
 
-# the sections in the order of the world file's documentation, with their names in the summary
-SECTIONS = (
-    ("patches", "patch", "patches"),
-    ("slopes", "hill", "hills"),
-    ("rails", "rail pair", "rail pairs"),
-    ("objects", "object", "objects"),
-    ("rows", "rows entry", "rows entries"),
-    ("polytunnels", "polytunnel", "polytunnels"),
-    ("walls", "wall", "walls"),
-)
+
+def sections() -> List[Tuple[str, str, str]]:
+    """(section, one, many) of every kind of numbered entries, in the registry's order."""
+    return [(kind.section, *kind.count_names) for kind in element_kinds() if not kind.single]
 
 
 def plant_count(world: WorldConfig) -> int:
@@ -36,47 +29,14 @@ def plant_count(world: WorldConfig) -> int:
     return rows + sum(len(t.plant_stations()) * len(t.table_offsets()) for t in world.polytunnels)
 
 
-def _along(x: float, y: float, yaw: float, u: float, v: float) -> Tuple[float, float]:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return x + c * u - s * v, y + s * u + c * v
-
-
-def _rectangle(x, y, yaw, us, vs) -> List[Tuple[float, float]]:
-    """The corners [m] of the rectangle us[0]..us[1] by vs[0]..vs[1] in a frame at (x, y) turned by yaw."""
-    return [_along(x, y, yaw, u, v) for u in us for v in vs]
-
-
 def extent(world: WorldConfig) -> Optional[Box]:
-    """The box [m] around everything on the ground (None for the ground alone); an object's by a
-    sphere around its centre (a mesh's by its origin), a row's plants by the jitter and radius."""
+    """The box [m] around everything on the ground (None for the ground alone): each element's
+    footprint, as its kind gives it (:mod:`thorvald_sim.world.footprints`)."""
     points: List[Tuple[float, float]] = []
-    for pa in world.patches:
-        points += pa.corners()
-    for sl in world.slopes:
-        half = sl.footprint_length / 2
-        points += _rectangle(sl.x, sl.y, sl.yaw, (-half, half), (-sl.width / 2, sl.width / 2))
-    for ra in world.rails:
-        side = ra.gauge / 2 + ra.radius
-        points += _rectangle(ra.x, ra.y, ra.yaw, (-ra.length / 2, ra.length / 2), (-side, side))
-    for ob in world.objects:
-        reach = {
-            "box": math.sqrt(ob.size_x**2 + ob.size_y**2 + ob.size_z**2) / 2,
-            "cylinder": math.hypot(ob.radius, ob.length / 2),
-            "sphere": ob.radius,
-        }.get(ob.shape, 0.0)
-        points += [(ob.x - reach, ob.y - reach), (ob.x + reach, ob.y + reach)]
-    for ro in world.rows:
-        margin = ro.jitter + ro.plant_radius
-        across = (ro.count - 1) * ro.spacing
-        points += _rectangle(ro.x, ro.y, ro.yaw, (-margin, ro.length + margin), (-margin, across + margin))
-    for tu in world.polytunnels:
-        side = (tu.width + tu.tube) / 2
-        points += _rectangle(tu.x, tu.y, tu.yaw, (-tu.length / 2, tu.length / 2), (-side, side))
-    for wa in world.walls:
-        points += _rectangle(wa.x, wa.y, wa.yaw, (-wa.length / 2, wa.length / 2), (-wa.thickness / 2, wa.thickness / 2))
-    hf = world.height_field
-    if hf is not None:
-        points += _rectangle(hf.x, hf.y, 0.0, (-hf.size_x / 2, hf.size_x / 2), (-hf.size_y / 2, hf.size_y / 2))
+    for kind in element_kinds():
+        if kind.footprint is not None:
+            for element in world.elements(kind.section):
+                points += kind.footprint(element)
     if not points:
         return None
     xs, ys = [x for x, _ in points], [y for _, y in points]
@@ -90,7 +50,7 @@ def summary(world: WorldConfig) -> dict:
     return {
         "world": world.source,
         "description": world.description,
-        "elements": {key: len(getattr(world, key)) for key, _, _ in SECTIONS},
+        "elements": {key: len(world.elements(key)) for key, _, _ in sections()},
         "rows": sum(r.count for r in world.rows),
         "height_field": list(hf.grid_shape()) if hf is not None else None,
         "plants": plant_count(world),
@@ -100,7 +60,7 @@ def summary(world: WorldConfig) -> dict:
 
 def format_elements(s: dict) -> str:
     parts = []
-    for key, one, many in SECTIONS:
+    for key, one, many in sections():
         n = s["elements"][key]
         if n:
             parts.append(f"{n} {one if n == 1 else many}" + (f" ({s['rows']} rows)" if key == "rows" else ""))

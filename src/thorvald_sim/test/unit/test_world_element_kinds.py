@@ -4,7 +4,7 @@ The first part of this file is such a module: fence posts (``posts:``, entries `
 cylinder standing on the ground at ``x``, ``y``, of a ``radius`` and ``height``: its value type, its
 keys, its maker (with a rule between two keys), its budget and its scene builder. The registry line
 is ``registered(POSTS)``: the tests load world files with posts, read their values and problems,
-hold them to the budgets, and build them in pybullet.
+hold them to the budgets, build them in pybullet, and check_world counts them and their extent.
 """
 
 import math
@@ -18,6 +18,7 @@ from sim_test_helpers import ray_down
 from thorvald_model.errors import Problem
 from thorvald_model.schema import Key
 from thorvald_sim import world as world_module
+from thorvald_sim.check_world import format_elements, summary
 from thorvald_sim.scene import build_scene, builder_of
 from thorvald_sim.world import (
     BUILT_IN,
@@ -79,9 +80,14 @@ def build_post(client: int, world, post: Post, name: str, bodies: dict) -> None:
     bodies[name] = p.createMultiBody(0, shape, -1, basePosition=centre, physicsClientId=client)
 
 
+def post_footprint(post: Post):
+    return [(post.x - post.radius, post.y - post.radius), (post.x + post.radius, post.y + post.radius)]
+
+
 POSTS = ElementKind(
-    "posts", "post", POST_KEYS, make_post, build_post, budget=bodies_each(looks=True), doc="fence posts"
-)
+    "posts", "post", POST_KEYS, make_post, build_post, budget=bodies_each(looks=True), doc="fence posts",
+    footprint=post_footprint,
+)  # fmt: skip
 
 # ---------------------------------------------------------------------------------------------
 # The tests
@@ -251,3 +257,12 @@ def test_a_limit_set_on_the_package_reaches_every_module_that_reads_it(monkeypat
     assert e.value.problems[0].rule == "makes 5 x 5 grid points; at most 10"
     monkeypatch.undo()
     assert budgets.MAX_FIELD_POINTS == elements.MAX_FIELD_POINTS == world_module.MAX_FIELD_POINTS == 1_000_000
+
+
+def test_check_world_counts_posts_and_takes_their_footprints_into_the_extent(tmp_path):
+    with registered(POSTS):
+        s = summary(load_world(write(tmp_path, {"posts": WORLD["posts"]})))
+        assert format_elements(s) == "3 posts"
+    assert s["elements"]["posts"] == 3
+    # post0 at (2, 1) and post2 at (12, -1), 5 cm in radius, bound it
+    assert s["extent"] == [1.95, -1.05, 12.05, 1.05]

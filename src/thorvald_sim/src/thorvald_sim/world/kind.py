@@ -67,6 +67,9 @@ class ElementKind:
     what one ground look-up searches (the ground, every hill and patch).
     check(elements, context): the rules between the section's elements, and with the rest of the
     world (what ``context.made`` holds), once all are made.
+    footprint(element): the points [m] of a box around it on the ground (the world's extent, in
+    ``check_world``; :mod:`thorvald_sim.world.footprints`). counted: how ``check_world`` counts the
+    section's entries, one and many ("hill", "hills").
     """
 
     section: str  # the top-level key: "walls"
@@ -83,11 +86,18 @@ class ElementKind:
     # the defaults a key's own cannot say (a colour, a surface kind's number), by key, for the table
     defaults: Mapping[str, str] = field(default_factory=dict)
     body: Optional[str] = None  # the body's name of a single mapping (default: its section)
+    footprint: Optional[Callable[[Any], Sequence[Tuple[float, float]]]] = None
+    counted: Tuple[str, str] = ()  # ("wall", "walls"); default: the prefix and the section
 
     @property
     def single(self) -> bool:
         """Whether the section is one mapping rather than numbered entries."""
         return self.prefix is None
+
+    @property
+    def count_names(self) -> Tuple[str, str]:
+        """(one, many): how an entry and several are counted ("wall", "walls")."""
+        return self.counted or (self.prefix or self.section, self.section)
 
     def body_name(self, element: Any) -> str:
         """The scene's name of the element's body: ``walls.wall0`` (a single mapping's: ``body``)."""

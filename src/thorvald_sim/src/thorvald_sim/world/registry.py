@@ -1,10 +1,10 @@
 """The registry of world element kinds: one :class:`~thorvald_sim.world.kind.ElementKind` a kind,
 in the order the loader makes them and the scene builds them.
 
-The loader (:func:`thorvald_sim.world.parse_world`) and the scene
-(:func:`thorvald_sim.scene.build_scene`) iterate :func:`element_kinds`; the schema's
-documentation is rendered from it (:func:`keys_markdown`). A new kind is a module of its own
-(value type, keys, maker, budget, scene builder) and one line in ``BUILT_IN``; a kind of a test or
+The loader (:func:`thorvald_sim.world.parse_world`), the scene
+(:func:`thorvald_sim.scene.build_scene`) and ``check_world`` iterate :func:`element_kinds`; the
+schema's documentation is rendered from it (:func:`keys_markdown`). A new kind is a module of its
+own (value type, keys, maker, budget, scene builder, footprint) and one line in ``BUILT_IN``; a kind of a test or
 of a user's program is added for a while with :func:`registered`.
 """
 
@@ -16,6 +16,7 @@ from typing import Iterator, List, Optional, Sequence, Tuple
 from thorvald_model.schema import KIND_NAMES, REQUIRED, Key
 
 from ..doc_tables import markers, with_table
+from . import footprints
 from .budgets import bodies_each, patches_budget, polytunnels_budget, rows_budget, walls_budget
 from .elements import (
     _height_field,
@@ -59,6 +60,7 @@ SURFACE_NUMBER = "the surface kind's, else 0"
 BUILT_IN: Tuple[ElementKind, ...] = (
     ElementKind(
         "height_field", None, HEIGHT_FIELD_KEYS, make=_height_field, builder="build_height_field",
+        footprint=footprints.height_field,
         check=_height_field_check, on_ground=False, body="ground",
         doc="uneven ground in place of the ground plane (beyond its edges there is no ground), of the ground's "
         "friction and colour",
@@ -69,6 +71,7 @@ BUILT_IN: Tuple[ElementKind, ...] = (
     ),
     ElementKind(
         "patches", "patch", PATCH_KEYS, make=_patch, builder="build_patch", budget=patches_budget,
+        footprint=footprints.patch, counted=("patch", "patches"),
         check=_patches_check, on_ground=False,
         doc="rectangles of another surface lying on the ground (a soft one let into it)",
         defaults={
@@ -80,14 +83,17 @@ BUILT_IN: Tuple[ElementKind, ...] = (
     ),
     ElementKind(
         "slopes", "slope", SLOPE_KEYS, make=_slope, builder="build_slope", budget=bodies_each(), on_ground=False,
+        footprint=footprints.slope, counted=("hill", "hills"),
         doc="hills along their own x axis: a ramp up, a flat top, a ramp down",
     ),
     ElementKind(
         "rails", "rail", RAIL_KEYS, make=_rail, builder="build_rail", budget=bodies_each(2.0), check=_rails_check,
+        footprint=footprints.rail, counted=("rail pair", "rail pairs"),
         on_ground=False, doc="pairs of parallel heating pipes, as in greenhouses",
     ),
     ElementKind(
         "objects", "object", OBJECT_KEYS, make=_object, builder="build_object", budget=bodies_each(looks=True),
+        footprint=footprints.world_object, counted=("object", "objects"),
         check=_objects_check, doc="single bodies: a box, cylinder, sphere or mesh file, static or moving",
         defaults={
             "z": "resting upright on the ground; a mesh's origin on it", "size_x": "required for a box",
@@ -98,14 +104,17 @@ BUILT_IN: Tuple[ElementKind, ...] = (
     ),
     ElementKind(
         "rows", "row", ROWS_KEYS, make=_rows, builder="build_rows", budget=rows_budget,
+        footprint=footprints.rows, counted=("rows entry", "rows entries"),
         doc="crop rows: parallel rows of plants from a few numbers", defaults={"rgba": _rgba("leaf green", RGBA_LEAF)},
     ),
     ElementKind(
         "polytunnels", "polytunnel", POLYTUNNEL_KEYS, make=_polytunnel, builder="build_polytunnel",
+        footprint=footprints.polytunnel, counted=("polytunnel", "polytunnels"),
         budget=polytunnels_budget, doc="Haygrove-type tunnels of hoops, with table-tops or ground beds of strawberries",
     ),
     ElementKind(
         "walls", "wall", WALL_KEYS, make=_wall, builder="build_wall", budget=walls_budget,
+        footprint=footprints.wall, counted=("wall", "walls"),
         doc="boxes standing on the ground", defaults={"rgba": _rgba("concrete", RGBA_CONCRETE)},
     ),
 )  # fmt: skip
