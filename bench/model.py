@@ -11,6 +11,10 @@
    sections (batteries, corners, pipes, beams), N = 10, 20, 40, 80, 100, 120, measured in this one
    run. Target: the time per drive at 100 drives at most 1.5 times the time per drive at 10 drives
    (linear growth; the recursion over names[1:] this replaced was quadratic from about 20 drives).
+3. Bad input: a "billion laughs" (9 levels of 10 aliases, 10^9 values in about 450 bytes) refused by
+   the shared loader (thorvald_model.schema.load_yaml), against yaml.safe_load of the standard
+   robot's file, the median of N each. Target: refused in less time than a robot file takes to load
+   (the bound stops it after 10^5 values, before levels f to i are composed).
 """
 
 import argparse
@@ -30,6 +34,7 @@ PKG = os.path.join(ROOT, "src", "thorvald_model")
 sys.path.insert(0, os.path.join(PKG, "src"))
 
 from thorvald_model.description import generate_urdf  # noqa: E402
+from thorvald_model.schema import YamlBoundError, load_yaml  # noqa: E402
 
 TARGET_9WD9WS = 1.0  # [s], cold
 TARGET_GROWTH = 1.5  # time per drive at 100 drives / at 10 drives
@@ -97,6 +102,39 @@ def growth(repeat: int) -> dict:
     return per_drive
 
 
+def bomb(levels: int = 9, fan: int = 10) -> str:
+    """Level a holds fan scalars, each next level fan aliases of the one before: fan^levels values."""
+    names = "abcdefghijklmnopqrstuvwxyz"[:levels]
+    lines = [f"  a: &a [{', '.join(['lol'] * fan)}]"]
+    for prev, name in zip(names, names[1:]):
+        lines.append(f"  {name}: &{name} [{', '.join(['*' + prev] * fan)}]")
+    return "lol:\n" + "\n".join(lines) + "\n"
+
+
+def bad_input(repeat: int) -> float:
+    """(bomb refused, robot file loaded) [s], medians; prints both and their ratio."""
+    text = bomb()
+    std = os.path.join(PKG, "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
+    with open(std) as f:
+        robot = f.read()
+    refused, loaded = [], []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        try:
+            load_yaml(text)
+        except YamlBoundError:
+            refused.append(time.perf_counter() - start)
+        else:
+            raise SystemExit("the bomb was not refused")
+        start = time.perf_counter()
+        yaml.safe_load(robot)
+        loaded.append(time.perf_counter() - start)
+    bomb_s, robot_s = statistics.median(refused), statistics.median(loaded)
+    print(f"\nbad input: a {len(text)}-byte billion laughs refused in {1000 * bomb_s:.2f} ms; "
+          f"the standard robot's file loads in {1000 * robot_s:.2f} ms ({bomb_s / robot_s:.2f} x)")  # fmt: skip
+    return bomb_s / robot_s
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeat", type=int, default=5)
@@ -104,6 +142,7 @@ def main() -> int:
     worst = example_robots(args.repeat)
     per_drive = growth(args.repeat)
     ratio = per_drive[100] / per_drive[10]
+    bomb_ratio = bad_input(args.repeat)
     ok_cold = worst < TARGET_9WD9WS
     ok_growth = ratio <= TARGET_GROWTH
     print(
@@ -114,7 +153,9 @@ def main() -> int:
         f"target: time per drive at 100 drives at most {TARGET_GROWTH} x that at 10: "
         f"{'met' if ok_growth else 'MISSED'} ({ratio:.2f} x)"
     )
-    return 0 if ok_cold and ok_growth else 1
+    ok_bomb = bomb_ratio < 1.0
+    print(f"target: the bomb refused in less time than the robot file loads: {'met' if ok_bomb else 'MISSED'}")
+    return 0 if ok_cold and ok_growth and ok_bomb else 1
 
 
 if __name__ == "__main__":

@@ -22,7 +22,21 @@ from std_srvs.srv import SetBool
 
 from thorvald_msgs.msg import BaseState
 
-HOLD = 1.2  # [s]: longer than the 0.5 s command timeout, while commands keep arriving
+HOLD = 1.2  # [s] of the driver's time: longer than the 0.5 s command timeout, while commands keep arriving
+
+
+def stamp(msg) -> float:
+    return msg.header.stamp.to_sec()
+
+
+def held_for(commands, start, first, seconds):
+    """The commands the driver stamped from first's stamp to seconds later (received after wall time
+    start), once it has stamped one that late; None if it has not within WAIT + seconds. On the
+    driver's own clock: a busy machine changes how many come, not which instants they cover."""
+    last = commands.wait_for(lambda m: stamp(m) >= stamp(first) + seconds, timeout=WAIT + seconds, since=start)
+    if last is None:
+        return None
+    return [m for m in commands.since(start) if stamp(first) <= stamp(m) <= stamp(last)]
 
 
 class SafetyStopTest(unittest.TestCase):
@@ -49,12 +63,13 @@ class SafetyStopTest(unittest.TestCase):
         response = self.safety_stop(True)
         self.assertTrue(response.success)
         self.assertEqual(response.message, "safety stop enabled")
-        first = self.commands.wait_for(lambda m: commands_are(m, held), timeout=WAIT)
-        self.assertIsNotNone(first, "the wheels were not stopped: " + describe(self.commands.latest()))
-        # held while the command keeps streaming; the measured wheels ramp down to 0 (1.5 m/s^2)
         start = time.time()
-        time.sleep(HOLD)
-        during = self.commands.since(start)
+        first = self.commands.wait_for(lambda m: commands_are(m, held), timeout=WAIT, since=start)
+        self.assertIsNotNone(first, "the wheels were not stopped: " + describe(self.commands.latest()))
+        # held while the command keeps streaming, for HOLD of the driver's time (its commands at 50 Hz);
+        # the measured wheels ramp down to 0 (1.5 m/s^2)
+        during = held_for(self.commands, start, first, HOLD)
+        self.assertIsNotNone(during, "the driver stopped publishing commands")
         self.assertGreater(len(during), 10)
         for m in during:
             self.assertTrue(commands_are(m, held), describe(m))
@@ -74,10 +89,12 @@ class SafetyStopTest(unittest.TestCase):
 
     def test_enabled_without_a_command_holds_a_later_command(self):
         self.assertTrue(self.safety_stop(True).success)
-        self.cmd.send(twist(0.5))
         start = time.time()
-        time.sleep(0.6)
-        during = self.commands.since(start)
+        self.cmd.send(twist(0.5))
+        first = self.commands.wait_for(timeout=WAIT, since=start)
+        self.assertIsNotNone(first, "the driver publishes no commands")
+        during = held_for(self.commands, start, first, 0.6)  # past the 0.5 s command timeout
+        self.assertIsNotNone(during, "the driver stopped publishing commands")
         self.assertGreater(len(during), 5)
         for m in during:
             self.assertTrue(all(v == 0.0 for v in m.prop_speed), describe(m))

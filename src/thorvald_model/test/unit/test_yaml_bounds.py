@@ -6,7 +6,6 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 import tracemalloc
 
 import pytest
@@ -142,21 +141,18 @@ def test_size_counts_aliases_expanded(load):
 
 
 @pytest.mark.parametrize("load", LOADERS)
-def test_a_billion_laughs_is_refused_quickly_in_little_memory(load):
+def test_a_billion_laughs_is_refused_before_it_is_expanded_in_little_memory(load):
     text = bomb()
     tracemalloc.start()
-    start = time.perf_counter()
     with pytest.raises(YamlBoundError) as info:
         load(text)
-    elapsed = time.perf_counter() - start
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
     # 10^9 values expanded would be gigabytes and minutes. Counted: level a holds 11 values (the
     # list and its 10 scalars), b 1 + 10 x 11 = 111, ... e 111111, past 10^5: refused at e, on
     # the 6th line (0-based 5), before f to i are even composed
     assert "more than 100000 values" in str(info.value)
-    assert info.value.problem_mark.line == 5
-    assert elapsed < 0.5, elapsed
+    assert info.value.problem_mark.line == 5  # (how fast: bench/model.py, against loading a robot file)
     assert peak < 1_000_000, peak  # [bytes] measured: 15 kB (load_yaml), 24 kB (BoundedLoader)
 
 
@@ -275,10 +271,8 @@ def test_a_robot_file_with_a_bomb_under_an_unknown_key_is_refused(tmp_path):
     path = tmp_path / "robot.yaml"
     with open(STD) as f:
         path.write_text(f.read() + bomb())
-    start = time.perf_counter()
     with pytest.raises(ConfigError) as info:
         load_robot_config(str(path))
-    assert time.perf_counter() - start < 0.5
     text = str(info.value)
     assert "\n" not in text and text.startswith(f"{path}: refused at line ") and "aliases expanded" in text
 
@@ -312,20 +306,17 @@ def test_a_structure_that_holds_itself_is_shown_as_repr_shows_it():
     assert value_text(a) == repr(a) == "[1, [...]]" and value_text(d) == repr(d) == "{'d': {...}}"
 
 
-def test_a_huge_shared_value_is_shown_quickly_in_little_memory():
+def test_a_huge_shared_value_is_shown_cut_in_little_memory():
     value = shared_graph()  # 10^9 leaves, 81 list slots in memory
     tracemalloc.start()
-    start = time.perf_counter()
     text, whole = value_text_whole(value)
     problem_text = Problem("lol", value, "some rule").format("robot.yaml")
     shortened = short(value)
-    elapsed = time.perf_counter() - start
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
     assert not whole and len(text) == VALUE_TEXT and text.startswith("[[[[[[[[[0, 0, 0") and text.endswith("...")
     assert problem_text == f"robot.yaml: lol: {text}: some rule"
     assert isinstance(shortened, str) and len(shortened) == 60 and shortened.endswith("...")
-    assert elapsed < 0.1, elapsed  # [s] measured: well under a millisecond
     assert peak < 200_000, peak  # [bytes]
 
 
@@ -343,7 +334,6 @@ def test_long_strings_bytes_and_integers_are_cut_before_they_are_converted():
 # ---- the configuration as a ROS parameter tree (base_driver's path): parse_robot_config --------
 def test_a_parameter_tree_with_a_huge_shared_value_gets_bounded_messages():
     tree = {"base_calculator": "pltf_clc_std::PltfClcStd", "motor_drives": four_drives(), "lol": shared_graph()}
-    start = time.perf_counter()
     config = parse_robot_config(tree, "/base_driver parameters")  # an unknown key of the user's: kept
     (warning,) = config.warnings
     line = warning.format(config.source)
@@ -357,4 +347,3 @@ def test_a_parameter_tree_with_a_huge_shared_value_gets_bounded_messages():
     with pytest.raises(ConfigError) as info:
         parse_robot_config({"motor_drives": shared_graph()}, "/base_driver parameters")
     assert len(str(info.value)) < 1000
-    assert time.perf_counter() - start < 1.0
