@@ -7,7 +7,6 @@ from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
-import pybullet as p
 
 from ..errors import BlockError
 from .block import (
@@ -24,7 +23,7 @@ from .block import (
 )
 from .displays import cloud_display, image_display
 from .kind import SensorKind
-from .model import Sensor, rotate
+from .model import Sensor, p, rotate
 
 CAMERA_PLUGINS = ("libgazebo_ros_camera.so",)
 DEPTH_PLUGINS = ("libgazebo_ros_openni_kinect.so", "libgazebo_ros_depth_camera.so")

@@ -5,7 +5,6 @@ from dataclasses import dataclass
 from typing import Optional, Tuple
 
 import numpy as np
-import pybullet as p
 
 from .block import (
     FRAME_AS_IS,
@@ -21,7 +20,7 @@ from .block import (
     unpack,
 )
 from .kind import SensorKind, no_display
-from .model import Quat, Sensor, unrotate
+from .model import Quat, Sensor, p, unrotate
 
 IMU_SENSOR_PLUGINS = ("libgazebo_ros_imu_sensor.so",)
 MODEL_IMU_PLUGINS = ("libgazebo_ros_imu.so",)

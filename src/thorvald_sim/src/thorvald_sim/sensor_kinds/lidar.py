@@ -12,7 +12,6 @@ from dataclasses import dataclass, replace
 from typing import Optional, Tuple
 
 import numpy as np
-import pybullet as p
 
 from ..errors import BlockError
 from .block import (
@@ -29,7 +28,7 @@ from .block import (
 )
 from .displays import cloud_display, laser_display
 from .kind import SensorKind
-from .model import Sensor, Transform
+from .model import Sensor, Transform, p
 
 LASER_PLUGINS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")
 MULTILAYER_PLUGINS = (

@@ -1,7 +1,8 @@
 """What every kind of simulated sensor is built on: :class:`Sensor` (mounted on a link of a robot in
 pybullet, measured on its rate's grid of simulated time, its noise drawn per instant), the transforms
 between a link and a sensor frame, and :class:`ModelContext` (what a model may need beyond its block:
-gravity, the GNSS datum, other links of the robot). No ROS here.
+gravity, the GNSS datum, other links of the robot). No ROS here; pybullet is imported when a model
+first calls it (``p``), so that the blocks' readers, which import this module, stay pure.
 """
 
 import zlib
@@ -9,7 +10,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable, Dict, Optional, Tuple
 
 import numpy as np
-import pybullet as p
 
 from thorvald_base.rate_grid import RateGrid
 from thorvald_model.datum import Datum
@@ -19,6 +19,22 @@ from .block import SensorSpec
 
 if TYPE_CHECKING:  # the description's link tree (thorvald_sim.description reads the sensor blocks)
     from ..description import ParentJoint
+
+
+class _Pybullet:
+    """pybullet, imported when a model first calls it: the kinds' block readers beside the models
+    (thorvald_sim.sensor_blocks, the description, the RViz configuration) never load it. Each name
+    is looked up once, then held as an attribute."""
+
+    def __getattr__(self, name: str):
+        import pybullet  # noqa: PLC0415 (on purpose: see the class's docstring)
+
+        value = getattr(pybullet, name)
+        setattr(self, name, value)
+        return value
+
+
+p = _Pybullet()  # the kinds' models call pybullet through this
 
 Vec3 = Tuple[float, float, float]
 Quat = Tuple[float, float, float, float]

@@ -4,11 +4,10 @@ from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
-import pybullet as p
 
 from .block import FRAME_TF_RESOLVE, NON_NEGATIVE, Element, Pose, SensorSpec, Vec3, read_namespace, read_rate
 from .kind import SensorKind, no_display
-from .model import Quat, Sensor, unrotate
+from .model import Quat, Sensor, p, unrotate
 
 MODEL_P3D_PLUGINS = ("libgazebo_ros_p3d.so",)
 
