@@ -15,6 +15,8 @@ import subprocess
 
 import pytest
 
+pytestmark = pytest.mark.slow  # a process per case: the commands as a user types them
+
 WS = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 XACRO = os.path.join(WS, "src", "thorvald_model", "urdf", "thorvald_model.xacro")
 STANDARD = os.path.join(WS, "src", "thorvald_model", "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")

@@ -112,6 +112,7 @@ def test_with_noise_every_estimate_lies_within_three_standard_uncertainties(grou
 
 
 @pytest.mark.parametrize("ground_truth", GROUND_TRUTHS)
+@pytest.mark.slow  # many calibrations of noisy drives
 def test_the_stated_uncertainties_are_the_spread_of_the_estimates(ground_truth):
     """Over 20 seeds, the estimates' errors in units of their stated standard uncertainty have an
     RMS near 1: the uncertainties are neither optimistic nor so wide that 'within 3' says nothing."""

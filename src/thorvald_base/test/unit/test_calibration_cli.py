@@ -194,6 +194,7 @@ def _diff_file(tmp_path):
     return str(path)
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_rosrun_runs_it_and_refuses_without_a_traceback(tmp_path):
     not_a_bag = tmp_path / "notes.bag"
     not_a_bag.write_text("a drive, in words")

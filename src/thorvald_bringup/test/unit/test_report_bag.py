@@ -90,6 +90,7 @@ def run_report(*args):
     )
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_odometry_report_from_a_bag_prints_the_table_and_writes_figures_8_and_9(tmp_path, drive):
     write_bag(tmp_path / "drive.bag", drive)
     out = tmp_path / "report"
@@ -105,6 +106,7 @@ def test_odometry_report_from_a_bag_prints_the_table_and_writes_figures_8_and_9(
         assert f"{png}" in r.stdout
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_odometry_report_refuses_a_bag_of_another_robot_and_a_bad_robot_with_one_line(tmp_path, drive):
     write_bag(tmp_path / "drive.bag", drive)
     r = run_report("--bag", str(tmp_path / "drive.bag"), "--robot", "thorvald_ii_4wd4ws_std", "--out", str(tmp_path))

@@ -195,6 +195,7 @@ def test_an_exported_calculator_whose_module_is_missing_names_the_export(tmp_pat
     )
 
 
+@pytest.mark.slow  # a fresh interpreter
 def test_without_the_calculators_package_every_file_is_refused_never_passed(tmp_path):
     """thorvald_model alone (thorvald_base not importable): the example robot's calculator cannot be
     loaded, so check_config refuses the file (it used to pass it on the shared rules alone)."""
@@ -300,6 +301,7 @@ def test_no_module_imports_a_package_above_it_in_its_source():
     assert upward == {}
 
 
+@pytest.mark.slow  # a fresh interpreter a module
 def test_importing_every_module_in_a_clean_interpreter_loads_no_package_above_it():
     script = textwrap.dedent(
         """\

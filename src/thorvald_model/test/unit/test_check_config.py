@@ -68,6 +68,7 @@ def test_json_summary(capsys):
     assert (row["drives"], row["steered"], row["passive"]) == (4, 4, 0)
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_rosrun_entry_point_exits_2_without_traceback(bad_file):
     proc = subprocess.run(
         ["rosrun", "thorvald_model", "check_config", bad_file], capture_output=True, text=True, timeout=60

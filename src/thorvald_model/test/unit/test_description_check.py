@@ -68,6 +68,7 @@ def test_extras_written_for_another_prefix_say_which_link_was_meant():
     assert tree.find("joint[@name='lidar_joint']/parent").get("link") == "thorvald_001/base_link"
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_generate_urdf_cli_prints_the_problems_and_exits_2(tmp_path):
     out = tmp_path / "robot.urdf"
     result = run_module("thorvald_model.generate_urdf", STD, "--extras", MISSING_LINK, "-o", str(out))
@@ -77,6 +78,7 @@ def test_generate_urdf_cli_prints_the_problems_and_exits_2(tmp_path):
     assert not out.exists()
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_xacro_wrapper_prints_the_problems_writes_nothing_and_exits_2(tmp_path):
     out = tmp_path / "robot.urdf"
     result = run_module(
@@ -88,6 +90,7 @@ def test_xacro_wrapper_prints_the_problems_writes_nothing_and_exits_2(tmp_path):
     assert not out.exists()
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_xacro_wrapper_normalises_as_generate_urdf_does():
     result = run_module(
         "thorvald_model.xacro_wrapper", XACRO, "robot_config:=" + STD, "model_extras:=" + SLASHED, "tf_prefix:=r1"
@@ -98,6 +101,7 @@ def test_xacro_wrapper_normalises_as_generate_urdf_does():
     assert structural_differences(tree, ET.fromstring(generate_urdf(STD, tf_prefix="r1", model_extras=SLASHED))) == []
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_xacro_wrapper_lists_dependencies_without_checking():
     result = run_module(
         "thorvald_model.xacro_wrapper", "--deps", XACRO, "robot_config:=" + STD, "model_extras:=" + MISSING_LINK

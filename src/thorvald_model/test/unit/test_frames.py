@@ -53,6 +53,7 @@ def test_both_conventions_give_one_description(config):
     assert block.findtext("robotBaseFrame") == "thorvald_001/base_link"
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_the_xacro_command_takes_the_older_convention(tmp_path):
     """The command users' launch files run (our xacro wrapper) normalises the prefix too."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.join(PKG, "src"), os.environ.get("PYTHONPATH", "")]))

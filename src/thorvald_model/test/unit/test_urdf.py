@@ -46,6 +46,7 @@ def links(tree):
 
 # --- every robot ------------------------------------------------------------------------------
 @robots
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_check_urdf_accepts_the_robot(robot, tmp_path):
     path = tmp_path / "robot.urdf"
     path.write_text(urdf_text(robot))
@@ -318,6 +319,7 @@ def run_module(module, *args):
     return subprocess.run([sys.executable, "-m", module, *args], capture_output=True, text=True, env=ENV)
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_cli_prints_the_urdf():
     result = run_module("thorvald_model.generate_urdf", FIGURE5, "--tf-prefix", "robot_1/", "--robot-name", "r1")
     assert result.returncode == 0, result.stderr
@@ -333,6 +335,7 @@ def test_cli_prints_the_urdf():
         ("thorvald_model.xacro_wrapper", [os.path.join(PKG, "urdf", "thorvald_model.xacro")]),
     ],
 )
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_cli_prints_the_loaders_problems_and_exits_2(tmp_path, module, extra):
     bad = tmp_path / "bad.yaml"
     bad.write_text("motor_drives:\n  drive0: {node: 1, x: 0.5, y: 0.3, r_wheel: -0.2, str_lm: 1}\n")
@@ -345,12 +348,14 @@ def test_cli_prints_the_loaders_problems_and_exits_2(tmp_path, module, extra):
     assert "motor_drives.drive0.str_lm" in result.stderr and "did you mean 'str_lim'?" in result.stderr
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_cli_reports_a_missing_extras_file_and_exits_2(tmp_path):
     result = run_module("thorvald_model.generate_urdf", FIGURE5, "--extras", str(tmp_path / "nope.xacro"))
     assert result.returncode == 2
     assert "Traceback" not in result.stderr and "nope.xacro" in result.stderr
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_xacro_wrapper_output_equals_the_library_output():
     xacro_file = os.path.join(PKG, "urdf", "thorvald_model.xacro")
     result = run_module("thorvald_model.xacro_wrapper", xacro_file, "robot_config:=" + FIGURE5, "tf_prefix:=a/")
@@ -358,6 +363,7 @@ def test_xacro_wrapper_output_equals_the_library_output():
     assert structural_differences(ET.fromstring(result.stdout.encode()), urdf_tree(FIGURE5, "a/")) == []
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_generation_is_pure():
     # URDF generation belongs to the pure core: no rospy, no messages, no pybullet.
     code = (

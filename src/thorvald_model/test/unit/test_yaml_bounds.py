@@ -114,6 +114,7 @@ def test_a_deep_file_gets_one_line_naming_the_file_and_the_rule(tmp_path):
 
 
 # ---- size with aliases expanded ----------------------------------------------------------------
+@pytest.mark.slow  # reads files at the size bound
 def test_size_at_the_bound_is_read_and_one_past_it_refused():
     load = load_yaml  # (BoundedLoader counts with the same code, 2.5 times slower: 2 x 2.4 s)
     # a list of n scalars is n + 1 values

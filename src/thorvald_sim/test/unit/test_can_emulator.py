@@ -240,6 +240,7 @@ def test_buses_that_cannot_open_give_one_line(interface, channel, message):
 
 @settings(max_examples=400, deadline=None)
 @given(st.integers(0, 0x7FF), st.binary(min_size=0, max_size=8), st.booleans())
+@pytest.mark.slow  # hypothesis: many frames
 def test_any_frame_is_routed_without_raising(can_id, data, extended):
     handle = CanBase(load_robot_config(STD), bus=None)
     handle._route(Frame(can_id, data, extended), 1.0)

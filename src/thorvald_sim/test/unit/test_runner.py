@@ -73,6 +73,7 @@ def test_a_robot_drives_its_commands_and_its_odometry_follows(tmp_path):
     assert summary["end_point_difference_m"] < 0.02 and summary["simulated_s"] == pytest.approx(5.5)
 
 
+@pytest.mark.slow  # two drives of 4 simulated seconds
 def test_two_runs_write_the_same_files(tmp_path):
     commands = [TimedTwist(0.5, 0.4, 0.0, 0.0), TimedTwist(3.0, 0.3, 0.1, 0.4), TimedTwist(6.0, 0.0, 0.0, 0.0)]
     for k in (1, 2):
@@ -81,6 +82,7 @@ def test_two_runs_write_the_same_files(tmp_path):
         assert (tmp_path / "r1" / name).read_bytes() == (tmp_path / "r2" / name).read_bytes(), name
 
 
+@pytest.mark.slow  # two drives, one measuring every sensor
 def test_sensors_are_recorded_only_when_asked(tmp_path):
     commands = [TimedTwist(0.2, 0.3, 0.0, 0.0), TimedTwist(1.0, 0.0, 0.0, 0.0)]
     run_robot(STD, commands, RunOptions(model_extras=SENSORS), out_dir=str(tmp_path / "plain"))
@@ -97,6 +99,7 @@ def test_sensors_are_recorded_only_when_asked(tmp_path):
     assert camera["image"].shape[1:] == (240, 320, 3) and "rgba" not in camera.files
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_the_command_line_writes_its_files_and_refuses_a_broken_commands_file(tmp_path):
     cmds = tmp_path / "cmds.csv"
     cmds.write_text("t,vx,vy,wz\n0.5,0.5,0,0\n2.0,0,0,0\n")

@@ -153,6 +153,7 @@ def test_a_block_past_a_bound_is_refused_at_spawn_and_reported_while_the_robot_h
     assert values == {"robot": "probe", "sensor": "big", "topics": "none", "why": disabled[0].what}
 
 
+@pytest.mark.slow  # half a million rays
 def test_a_lidar_at_the_bound_of_rays_reads_every_ray(world):
     # 4096 columns over +-30 degrees x 128 channels over +-15 degrees: MAX_RAYS = 524288 rays, 33 calls
     # of at most 16383. Every beam meets the wall's face x = 3 m (|y| = 3 tan h <= 1.73 m, z = 1 m +

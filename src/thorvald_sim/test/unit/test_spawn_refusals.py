@@ -214,6 +214,7 @@ def check_as_built(*args):
     )
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_check_as_built_summarises_a_valid_file(tmp_path):
     path = tmp_path / "built.yaml"
     path.write_text(
@@ -248,6 +249,7 @@ def test_check_as_built_summarises_a_valid_file(tmp_path):
     assert row[1:6] == ["0.20000", "0.20000", "+0.00", "+0.00", "+0.000"]
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_check_as_built_takes_a_profile_and_says_a_drive_does_not_steer():
     proc = check_as_built("field:3", "--robot-model", DIFF_PATH, "--json")
     assert proc.returncode == 0, proc.stderr
@@ -262,6 +264,7 @@ def test_check_as_built_takes_a_profile_and_says_a_drive_does_not_steer():
     assert "tyres     loaded" in text
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_check_as_built_lists_every_problem_on_stderr_and_exits_2(tmp_path):
     path = tmp_path / "bad.yaml"
     path.write_text("motor_drives:\n  drive9: {r_wheel: 0.2}\n  drive0: {steering_offset: 0.9}\ndelay: 7\n")
@@ -283,12 +286,14 @@ def test_check_as_built_lists_every_problem_on_stderr_and_exits_2(tmp_path):
         (["field:1", "--robot-model", "/nonexistent/robot.yaml"], "cannot read the robot configuration"),
     ],
 )
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_check_as_built_refuses_a_bad_spec_or_robot_file_in_one_line(args, says):
     proc = check_as_built(*args)
     assert proc.returncode == 2 and proc.stdout == ""
     assert len(proc.stderr.splitlines()) == 1 and says in proc.stderr, proc.stderr
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_check_as_built_refuses_a_bomb_in_one_line(tmp_path):
     path = tmp_path / "bomb.yaml"
     path.write_text(BOMB)

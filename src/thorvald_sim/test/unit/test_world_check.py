@@ -34,6 +34,7 @@ def write(tmp_path, name, data):
     return str(path)
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_a_valid_world_is_summarised(tmp_path):
     path = write(tmp_path, "ok.yaml", WORLD)
     status, out, err = check_world(path)
@@ -49,6 +50,7 @@ def test_a_valid_world_is_summarised(tmp_path):
     ]
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_an_invalid_world_prints_every_problem_on_stderr_and_exits_2(tmp_path):
     bad = {"patches": {"patch0": {"x": 2e4, "y": 0, "size_x": 0, "size_y": 1, "lateral_friction": 0.5}}}
     bad["walls"] = {"wall0": {"x": 0, "y": 0, "length": 1e9}}
@@ -64,6 +66,7 @@ def test_an_invalid_world_prints_every_problem_on_stderr_and_exits_2(tmp_path):
     ]
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_a_world_over_a_budget_is_refused_by_the_command_at_once(tmp_path):
     rows = {f"row{i}": {"x": 0, "y": i, "length": 999, "plant_spacing": 1} for i in range(100)}
     path = write(tmp_path, "many.yaml", {"rows": rows})
@@ -72,6 +75,7 @@ def test_a_world_over_a_budget_is_refused_by_the_command_at_once(tmp_path):
     assert "rows.row0.plant_spacing: 1: makes 100000 plants over the world's rows and polytunnels" in err
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_a_shipped_world_by_name_through_rosrun():
     if shutil.which("rosrun") is None:
         pytest.fail("rosrun is not on the PATH: source the workspace's devel/setup.bash")
@@ -87,6 +91,7 @@ def test_a_shipped_world_by_name_through_rosrun():
     assert 2150 < plant_count(world) < 2471
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_several_files_make_a_table_and_count_the_invalid_ones(tmp_path):
     status, out, err = check_world("flat", "polytunnel", write(tmp_path, "ok.yaml", WORLD), "no_such_world")
     assert status == 2
@@ -99,6 +104,7 @@ def test_several_files_make_a_table_and_count_the_invalid_ones(tmp_path):
     ]
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_json_summaries():
     status, out, _ = check_world("--json", "polytunnel", "vineyard")
     assert status == 0
@@ -110,6 +116,7 @@ def test_json_summaries():
     assert vineyard["extent"] == [-10.0, -18.0, 60.0, 18.0]  # the field: 70 x 36 m about (25, 0)
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_the_command_needs_no_pybullet():
     probe = (
         "import sys; from thorvald_sim.check_world import main; status = main(['vineyard', 'crop_rows']); "

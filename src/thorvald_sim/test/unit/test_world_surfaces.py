@@ -245,6 +245,7 @@ HOLES = {
 
 
 @pytest.mark.parametrize("holes", list(HOLES))
+@pytest.mark.slow  # a dense grid of probes
 def test_the_ground_pieces_cover_the_square_but_the_holes_once_each(holes):
     extent = 20.0
     pieces = ground_pieces(HOLES[holes], extent)
@@ -421,6 +422,7 @@ def _wheel_heights(sim, robot):
     return [p.getLinkState(robot.body, j, physicsClientId=sim.client)[0][2] for j, _, _ in robot.wheels]
 
 
+@pytest.mark.slow  # seconds of physics
 def test_a_rolling_wheel_sinks_as_its_load_says_and_still_rolls_r_omega():
     # The standard robot (177 kg: 380 to 490 N a wheel) drives at 0.5 m/s from tarmac onto 12 m of mud.
     client = p.connect(p.DIRECT)
@@ -541,6 +543,7 @@ def test_a_coasting_wheel_slows_as_its_rolling_resistance_says(client):
     assert sand == pytest.approx(0.05 * G / 0.3, rel=0.1)
 
 
+@pytest.mark.slow  # seconds of physics
 def test_a_driven_wheel_needs_its_rolling_friction_times_its_load_in_torque():
     # The standard robot at a steady 0.5 m/s on tarmac and in mud (the kinds' rolling friction 0.003
     # and 0.04 m): its velocity motors hold the speed and pay the rolling resistance in torque.
@@ -656,6 +659,7 @@ def test_farm_track_is_a_soft_field_with_a_track_through_a_muddy_gateway():
                 assert not any(pa.contains(i / 20, j / 20) for pa in world.patches)
 
 
+@pytest.mark.slow  # seconds of physics
 def test_the_standard_robot_drives_through_the_farm_tracks_gateway_and_sinks_in_its_mud():
     client = p.connect(p.DIRECT)
     try:

@@ -315,6 +315,7 @@ def test_quit_while_moving_stops_the_robot_and_restores_the_terminal(start_teleo
     assert "Traceback" not in terminal.screen()
 
 
+@pytest.mark.slow  # a process per case: the command as a user types it
 def test_refuses_to_start_without_a_terminal(tmp_path):
     env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:9", ROS_HOME=str(tmp_path))  # no master needed
     out = subprocess.run(
