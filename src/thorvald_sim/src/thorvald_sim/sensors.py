@@ -36,8 +36,27 @@ from .sensor_kinds.camera import Camera, Frame, depth_to_points
 from .sensor_kinds.gnss import Gnss, GnssReading
 from .sensor_kinds.imu import Imu, ImuReading
 from .sensor_kinds.lidar import RAY_BATCH, Lidar, Scan, beams, ranges_from_hits
-from .sensor_kinds.model import IDENTITY, InstantNoise, ModelContext, Sensor, Transform, find_mount, transform
+from .sensor_kinds.model import IDENTITY, InstantNoise, ModelContext, Sensor, Transform, compose, transform
 from .sensor_kinds.p3d import LinkTruth, P3d
+
+
+def find_mount(
+    tree: Dict[str, ParentJoint], joint_index: Dict[str, int], link: str, offset: Transform = IDENTITY
+) -> Tuple[int, Transform]:
+    """(pybullet link index, sensor frame in that link's frame) of a sensor on ``link``: up the fixed
+    joints to the nearest link pybullet kept (-1: the base)."""
+    chain = offset
+    seen = set()
+    while link in tree:
+        joint = tree[link]
+        if joint.type != "fixed" and joint.joint in joint_index:
+            return joint_index[joint.joint], chain
+        if link in seen:
+            raise MountError(f"link {link} is in a loop of joints")
+        seen.add(link)
+        chain = compose(transform(joint.origin.xyz, joint.origin.rpy), chain)
+        link = joint.parent
+    return -1, chain
 
 
 @dataclass(frozen=True)

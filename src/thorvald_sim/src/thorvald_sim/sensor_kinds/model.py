@@ -7,18 +7,14 @@ first calls it (``p``), so that the blocks' readers, which import this module, s
 
 import zlib
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable, Dict, Optional, Tuple
+from typing import Callable, Optional, Tuple
 
 import numpy as np
 
 from thorvald_base.rate_grid import RateGrid
 from thorvald_model.datum import Datum
 
-from ..errors import MountError
 from .block import SensorSpec
-
-if TYPE_CHECKING:  # the description's link tree (thorvald_sim.description reads the sensor blocks)
-    from ..description import ParentJoint
 
 
 class _Pybullet:
@@ -70,25 +66,6 @@ def rotate(quat: Quat, v) -> np.ndarray:
 def unrotate(quat: Quat, v) -> np.ndarray:
     m = np.asarray(p.getMatrixFromQuaternion(quat)).reshape(3, 3)
     return m.T @ np.asarray(v, dtype=float)
-
-
-def find_mount(
-    tree: Dict[str, "ParentJoint"], joint_index: Dict[str, int], link: str, offset: Transform = IDENTITY
-) -> Tuple[int, Transform]:
-    """(pybullet link index, sensor frame in that link's frame) of a sensor on ``link``: up the fixed
-    joints to the nearest link pybullet kept (-1: the base)."""
-    chain = offset
-    seen = set()
-    while link in tree:
-        joint = tree[link]
-        if joint.type != "fixed" and joint.joint in joint_index:
-            return joint_index[joint.joint], chain
-        if link in seen:
-            raise MountError(f"link {link} is in a loop of joints")
-        seen.add(link)
-        chain = compose(transform(joint.origin.xyz, joint.origin.rpy), chain)
-        link = joint.parent
-    return -1, chain
 
 
 class InstantNoise:

@@ -8,10 +8,7 @@ numpy and PIL are imported when a field is made, so that importing the world sta
 import math
 import random
 import warnings
-from typing import TYPE_CHECKING, Tuple
-
-if TYPE_CHECKING:
-    from .values import HeightField
+from typing import Tuple
 
 FLAT_BLEND = 1.0  # [m] over which a height field rises from its flat disc to full height
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -43,7 +40,8 @@ def _image_levels(path: str):
     return levels
 
 
-def _field_heights(hf: "HeightField"):
+def _field_heights(hf):
+    """The heights [m] of a height field (a thorvald_sim.world.values.HeightField) on its grid."""
     import numpy as np  # noqa: PLC0415
 
     nx, ny = hf.grid_shape()
