@@ -143,6 +143,16 @@ def rotate(q: Quat, v: Vec3) -> Vec3:
     )
 
 
+IDENTITY_TRANSFORM: Transform = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+
+
+def compose(a: Transform, b: Transform) -> Transform:
+    """The transform a then b (b expressed in a's child frame)."""
+    (ax, ay, az), qa = a
+    bx, by, bz = rotate(qa, b[0])
+    return (ax + bx, ay + by, az + bz), quaternion_multiply(qa, b[1])
+
+
 class JointTree:
     """The transforms of a robot description's joints, as robot_state_publisher computes them."""
 
