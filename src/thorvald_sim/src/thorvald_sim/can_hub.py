@@ -5,7 +5,7 @@ Each port is a pseudo-terminal whose far end a process opens as an SLCAN adapter
 participant (the device emulator) on python-can's ``virtual`` bus, so every participant sees every
 other one's frames, as on a wire. SLCAN commands (``O``, ``C``, ``S8``, ``V``, ``N`` ...) are
 acknowledged as an adapter does. A port can be dropped (its pseudo-terminal closed, as an adapter
-unplugged) and comes back at the same link path.
+unplugged: its link goes away with it) and comes back at the same link path.
 
 No ROS here; ``can_emulator_node`` runs a hub with the emulator.
 """
@@ -87,7 +87,12 @@ class SlcanPort:
         self.channel_open = False
 
     def close(self) -> None:
-        """As an adapter unplugged: the terminal goes away (the link stays, dangling, until reopened)."""
+        """As an adapter unplugged: the terminal and its link go away, as udev removes an unplugged
+        adapter's device and its link, until reopened. A link left dangling pointed at a terminal
+        number the system hands to the next process that opens one: a driver reopening it reached
+        another emulator's bus (two SLCAN rostests side by side)."""
+        if self.link and os.path.islink(self.link) and os.readlink(self.link) == self.path:
+            os.unlink(self.link)
         if self.bus is not None:
             self.bus.shutdown()
             self.bus = None
