@@ -62,12 +62,29 @@ FOLLOW_HEADROOM = 2.0  # following states, the steering servo may turn this much
 
 @dataclass(frozen=True)
 class Pose2D:
-    """A spawn pose: base_link at (x, y, z) [m] turned by yaw [rad]."""
+    """A spawn pose: base_link at (x, y, z) [m] turned by yaw [rad] (and tilted by roll and pitch
+    [rad], for a robot set down on a slope; its odom frame stays level)."""
 
     x: float = 0.0
     y: float = 0.0
     z: float = 0.0
     yaw: float = 0.0
+    roll: float = 0.0
+    pitch: float = 0.0
+
+    @property
+    def quaternion(self) -> Tuple[float, float, float, float]:
+        return tuple(p.getQuaternionFromEuler((self.roll, self.pitch, self.yaw)))
+
+
+@dataclass(frozen=True)
+class MotorLoad:
+    """One drive's motors at an instant: torques [N m] and rates [rad/s] at the wheel and the steering axis."""
+
+    wheel_torque: float
+    wheel_rate: float
+    steering_torque: float
+    steering_rate: float
 
 
 Vec3 = Tuple[float, float, float]
@@ -118,7 +135,7 @@ class SimRobot:
         with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
             f.write(text)
         try:
-            orientation = p.getQuaternionFromEuler((0.0, 0.0, pose.yaw))
+            orientation = pose.quaternion
             with quiet_stdout():
                 self.body = p.loadURDF(
                     f.name, (pose.x, pose.y, pose.z), orientation, flags=LOAD_FLAGS, physicsClientId=client
@@ -293,6 +310,23 @@ class SimRobot:
             out.append(MeasuredDrive(s[0], w[1] * radius, w[0], s[1]))
         return out
 
+    def motor_torques(self) -> List[MotorLoad]:
+        """What each drive's motors deliver at the last step: the wheel's torque [N m] and turning rate
+        [rad/s] at the wheel, and the steering's about its axis (0 for a drive that does not steer):
+        the joints' motor torques the solver applied (pybullet's applied joint motor torque), what a
+        real drive's motor currents measure through its torque constant and gear."""
+        if self._drive_joints is None:
+            self._joint_drive_states()
+        if not self._drive_joints:
+            return []
+        read = iter(p.getJointStates(self.body, self._drive_joints, physicsClientId=self.client))
+        wheels = [next(read) for _ in self.wheels]
+        out = []
+        for steer, w in zip(self.steering, wheels):
+            s = next(read) if steer is not None else (0.0, 0.0, None, 0.0)
+            out.append(MotorLoad(w[3], w[1], s[3], s[1]))
+        return out
+
     def joint_states(self, joints: Sequence[int]) -> List[Tuple[float, float]]:
         """(position, velocity) of the given joint indices."""
         return [tuple(s[:2]) for s in p.getJointStates(self.body, list(joints), physicsClientId=self.client)]
@@ -344,7 +378,7 @@ class SimRobot:
     def reset(self) -> None:
         """Back to the spawn pose, at rest, joints at 0, wheels stopped."""
         c, pose = self.client, self.spawn_pose
-        link = ((pose.x, pose.y, pose.z), p.getQuaternionFromEuler((0.0, 0.0, pose.yaw)))
+        link = ((pose.x, pose.y, pose.z), pose.quaternion)
         com, orn = p.multiplyTransforms(*link, *self._inertial)
         p.resetBasePositionAndOrientation(self.body, com, orn, physicsClientId=c)
         p.resetBaseVelocity(self.body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=c)

@@ -38,7 +38,7 @@ import math
 import os
 import time
 from dataclasses import dataclass, field, fields
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 import pybullet as p
@@ -56,9 +56,9 @@ from thorvald_model.description import generate_urdf
 from thorvald_model.errors import MISSING, ConfigError, Problem
 
 from .as_built import as_built_for, for_simulator
-from .robot import Pose2D
+from .robot import Pose2D, Vec3
 from .simulation import Simulation
-from .world import load_world, resolve_world
+from .world import WorldConfig, load_world, resolve_world
 
 WHAT = "list of commands"
 ONCE = ("directions",)  # a lidar's beams in its frame: the same every reading
@@ -93,7 +93,10 @@ class RunOptions:
     tf_prefix: str = "thorvald_001/"
     x: float = 0.0  # [m] spawn pose
     y: float = 0.0
+    z: float = 0.0  # [m] base_link in the world: 0 stands on flat ground
     yaw: float = 0.0  # [rad]
+    roll: float = 0.0  # [rad] set down tilted (on a slope); the odom frame stays level
+    pitch: float = 0.0  # [rad]
     physics_rate: float = 240.0  # [Hz], the simulator's
     clock_rate: float = 80.0  # [Hz], the simulator's ~clock_rate: the instants base_driver answers
     driver: Dict = field(default_factory=dict)  # base_driver's private parameters (rate, estimator, ...)
@@ -218,6 +221,122 @@ class _InProcessPorts(Ports):
         return self.drives
 
 
+class RobotSession:
+    """One robot in a simulation of its own, driven by its base_driver core in lockstep, for as long
+    as its caller wants: what :func:`run_robot` runs a list of commands on, and what a caller who
+    decides each command from what the robot does (a design study's scenario) runs a controller on.
+
+    ``world`` (a loaded world) stands in for ``options.world`` when given. :meth:`run` advances
+    simulated time; between runs the caller reads the robot (:attr:`robot`: ground truth, the joints'
+    motor torques) and may push it (:meth:`push`). Close it (or use it as a context manager): it
+    holds a pybullet DIRECT client.
+    """
+
+    def __init__(self, robot_file: str, options: RunOptions = RunOptions(), world: Optional[WorldConfig] = None):
+        self.options = options
+        self.config = config = load_robot_config(robot_file)
+        self.driver = driver = DriverParams.from_dict(
+            {**options.driver, "base_handle": "simulated_joints", "lockstep": True}
+        )
+        urdf = generate_urdf(
+            robot_file, tf_prefix=options.tf_prefix, model_extras=options.model_extras, robot_name=options.robot_name
+        )
+        as_built = for_simulator(as_built_for(options.as_built, config), config) if options.as_built else None
+        self.world = world if world is not None else load_world(resolve_world(options.world))
+        self.client = client = p.connect(p.DIRECT)
+        try:
+            self.sim = sim = Simulation(client, self.world, options.physics_rate, seed=options.seed)
+            pose = Pose2D(options.x, options.y, options.z, options.yaw, options.roll, options.pitch)
+            self.robot = sim.spawn(options.robot_name, urdf, pose, as_built)
+            calculator = load_calculator(config, estimator=driver.estimator, projection=driver.projection)
+            self.drives = _SimulatedDrives(self.robot)
+            handle = create_base_handle(config, driver, _InProcessPorts(self.drives))
+            self.core = BaseDriverCore(config, calculator, handle, command_timeout=driver.command_timeout)
+            if options.calibration:
+                apply_calibration(self.core, options.calibration)
+        except BaseException:
+            p.disconnect(client)
+            raise
+        self.steps = LockstepCycles(self.core, driver.rate)
+        self.clock = RateGrid(options.clock_rate, sim.dt)
+        self.truth: List[Sample] = []
+        self.odometry: List[Sample] = []
+        self.sensors = list(self.robot.sensors) if options.record_sensors else []
+        self.recordings: Dict[str, List] = {s.spec.name: [] for s in self.sensors}
+        self.drive_wall = 0.0  # [s] of wall time spent in run()
+        self._push: Optional[Tuple[Vec3, Vec3]] = None
+        self._closed = False
+
+    @property
+    def time(self) -> float:
+        """[s] simulated."""
+        return self.sim.time
+
+    def push(self, force: Optional[Sequence[float]], at: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
+        """A force [N] in world axes on the frame at the point ``at`` [m] of base_link, every physics
+        step from now on (None: no more): a drawbar's pull, a wind."""
+        self._push = None if force is None else (tuple(float(f) for f in force), tuple(float(a) for a in at))
+
+    def run(
+        self,
+        until: float,
+        command: Callable[[float], Optional[Tuple[float, float, float]]],
+        stop: Optional[Callable[["RobotSession"], bool]] = None,
+    ) -> bool:
+        """Steps the simulation until simulated time ``until`` [s]. At every control cycle base_driver's
+        core is handed ``command(t)`` (a twist ``(vx, vy, wz)`` in base_link, or None for no command),
+        the instant's ground truth and odometry are recorded, then ``stop(self)`` may end the run
+        early (True). Returns whether it stopped early."""
+        started = time.monotonic()
+        try:
+            return self._run(until, command, stop)
+        finally:
+            self.drive_wall += time.monotonic() - started
+
+    def _run(self, until, command, stop) -> bool:
+        sim, robot, steps, clock, drives = self.sim, self.robot, self.steps, self.clock, self.drives
+        while sim.time < until - 1e-9:
+            if self._push is not None:
+                force, at = self._push
+                point, _ = p.multiplyTransforms(*robot.world_pose(), at, (0.0, 0.0, 0.0, 1.0))
+                p.applyExternalForce(robot.body, -1, force, point, p.WORLD_FRAME, physicsClientId=self.client)
+            sim.step()
+            now = sim.time
+            for sensor in self.sensors:
+                if sensor.due(now):
+                    self.recordings[sensor.spec.name].append((now, sensor.read(now)))
+            if not clock.due(now):
+                continue
+            t = stamp_time(now)
+            drives.on_states(robot.drive_states(t), t)
+            if not steps.due(t):
+                steps.answer(t)
+                continue
+            result, _refused = steps.cycle(t, command(t))
+            position, orientation = robot.odom_pose()
+            self.truth.append(Sample(t, position[0], position[1], _yaw(orientation)))
+            pose = result.odometry.pose
+            self.odometry.append(Sample(t, pose.x, pose.y, pose.yaw))
+            if stop is not None and stop(self):
+                return True
+        return False
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            self.core.shutdown(self.sim.time)
+        finally:
+            p.disconnect(self.client)
+
+    def __enter__(self) -> "RobotSession":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
 def run_robot(
     robot_file: str,
     commands: Sequence[TimedTwist],
@@ -229,37 +348,19 @@ def run_robot(
     extras file; RuntimeError when the simulator refuses the robot."""
     if not commands:
         raise ValueError("no commands")
-    config = load_robot_config(robot_file)
-    driver = DriverParams.from_dict({**options.driver, "base_handle": "simulated_joints", "lockstep": True})
-    urdf = generate_urdf(
-        robot_file, tf_prefix=options.tf_prefix, model_extras=options.model_extras, robot_name=options.robot_name
-    )
-    as_built = for_simulator(as_built_for(options.as_built, config), config) if options.as_built else None
-    world = load_world(resolve_world(options.world))
     started = time.monotonic()
-    client = p.connect(p.DIRECT)
-    try:
-        sim = Simulation(client, world, options.physics_rate, seed=options.seed)
-        robot = sim.spawn(options.robot_name, urdf, Pose2D(options.x, options.y, 0.0, options.yaw), as_built)
-        calculator = load_calculator(config, estimator=driver.estimator, projection=driver.projection)
-        drives = _SimulatedDrives(robot)
-        handle = create_base_handle(config, driver, _InProcessPorts(drives))
-        core = BaseDriverCore(config, calculator, handle, command_timeout=driver.command_timeout)
-        if options.calibration:
-            apply_calibration(core, options.calibration)
-        driving = time.monotonic()
-        result = _drive(sim, robot, LockstepCycles(core, driver.rate), drives, commands=commands, options=options)
-        drive_wall = time.monotonic() - driving
-        core.shutdown(sim.time)
-    finally:
-        p.disconnect(client)
+    stamped = StampedCommands()
+    for c in commands:
+        stamped.add(c.t, (c.vx, c.vy, c.wz))
+    with RobotSession(robot_file, options) as session:
+        session.run(commands[-1].t + options.hold, lambda t: stamped.at(t) if stamped.begun(t) else None)
     wall = time.monotonic() - started
-    truth, odometry, recordings = result
+    truth, odometry = session.truth, session.odometry
     summary = _summary(truth, odometry, sim_time=truth[-1].t if truth else 0.0, wall=wall)
     summary.update(
-        drive_wall_s=round(drive_wall, 3),
+        drive_wall_s=round(session.drive_wall, 3),
         robot=os.path.abspath(robot_file),
-        world=world.source,
+        world=session.world.source,
         as_built=options.as_built,
         calibration=options.calibration,
         model_extras=options.model_extras,
@@ -268,39 +369,8 @@ def run_robot(
     )
     run = RunResult(tuple(truth), tuple(odometry), summary)
     if out_dir is not None:
-        write_outputs(out_dir, run, recordings)
+        write_outputs(out_dir, run, session.recordings)
     return run
-
-
-def _drive(sim, robot, steps, drives, *, commands, options):
-    stamped = StampedCommands()
-    for c in commands:
-        stamped.add(c.t, (c.vx, c.vy, c.wz))
-    end = commands[-1].t + options.hold
-    clock = RateGrid(options.clock_rate, sim.dt)
-    truth, odometry = [], []
-    sensors = list(robot.sensors) if options.record_sensors else []
-    recordings: Dict[str, List] = {s.spec.name: [] for s in sensors}
-    while sim.time < end - 1e-9:
-        sim.step()
-        now = sim.time
-        for sensor in sensors:
-            if sensor.due(now):
-                recordings[sensor.spec.name].append((now, sensor.read(now)))
-        if not clock.due(now):
-            continue
-        t = stamp_time(now)
-        drives.on_states(robot.drive_states(t), t)
-        if not steps.due(t):
-            steps.answer(t)
-            continue
-        twist = stamped.at(t) if stamped.begun(t) else None
-        result, _refused = steps.cycle(t, twist)
-        position, orientation = robot.odom_pose()
-        truth.append(Sample(t, position[0], position[1], _yaw(orientation)))
-        pose = result.odometry.pose
-        odometry.append(Sample(t, pose.x, pose.y, pose.yaw))
-    return truth, odometry, recordings
 
 
 def _yaw(q) -> float:
@@ -356,6 +426,7 @@ def _arrays(readings) -> Dict[str, np.ndarray]:
 
 
 __all__ = [
+    "RobotSession",
     "RunOptions",
     "RunResult",
     "Sample",
