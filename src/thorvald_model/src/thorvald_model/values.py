@@ -71,6 +71,18 @@ class Drive:
     # enough to turn a loaded wheel on the spot on tarmac.
     prp_motor_torque: float = key(1.6, **POSITIVE)  # [N m]
     str_motor_torque: float = key(1.0, **POSITIVE)  # [N m]
+    # Ours: the motors as DC motors behind their gears, for energy (thorvald_design.energy). A 48 V
+    # motor of 3000 rpm has a back-EMF constant near 48 V x 0.9 / 314 rad/s = 0.14 V s/rad, which in SI
+    # is its torque constant [N m/A]: 1.6 N m takes 11 A. Windings of a quarter ohm, 0.6 A without load,
+    # and a two-stage planetary gear's 90 % (steering: 0.4 ohm, 0.4 A, 85 %).
+    prp_motor_kt: float = key(0.14, **POSITIVE)  # [N m/A] torque constant (= back-EMF constant [V s/rad])
+    prp_motor_r: float = key(0.25, **NON_NEGATIVE)  # [ohm] winding resistance
+    prp_motor_i0: float = key(0.6, **NON_NEGATIVE)  # [A] no-load current
+    prp_gear_eff: float = key(0.9, lambda v: 0 < v <= 1, "must be in (0, 1]")  # propulsion gear efficiency
+    str_motor_kt: float = key(0.14, **POSITIVE)  # [N m/A]
+    str_motor_r: float = key(0.4, **NON_NEGATIVE)  # [ohm]
+    str_motor_i0: float = key(0.4, **NON_NEGATIVE)  # [A]
+    str_gear_eff: float = key(0.85, lambda v: 0 < v <= 1, "must be in (0, 1]")  # steering gear efficiency
     steering_name: str = key("")  # joint name without tf_prefix, default "steeringN"
     wheel_name: str = key("")  # joint name without tf_prefix, default "wheelN"
     tower: bool = key(True)  # a tower module stands above the drive (model only)
@@ -125,6 +137,11 @@ class Battery:
     yaw: float = key(0.0)
     bat_mesh: int = key(0, **NON_NEGATIVE)
     with_battery: bool = key(True)
+    # Ours: the battery a KC enclosure holds, for energy and the CAN emulator: a 48 V lithium pack of
+    # 100 Ah (4.8 kWh) with 50 milliohm inside
+    capacity: float = key(100.0, **POSITIVE)  # [Ah]
+    voltage: float = key(48.0, **POSITIVE)  # [V] nominal (open circuit)
+    internal_resistance: float = key(0.05, **NON_NEGATIVE)  # [ohm]
 
     @property
     def present(self) -> bool:
