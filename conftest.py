@@ -33,6 +33,6 @@ def ros_env(tmp_path_factory):
 def pytest_collection_modifyitems(config, items):
     for item in items:
         module = getattr(item, "module", None)
-        starts_ros = module is not None and any(v in _STARTS_ROS for v in vars(module).values())
+        starts_ros = module is not None and any(v is s for v in vars(module).values() for s in _STARTS_ROS)
         if "ros_env" in getattr(item, "fixturenames", ()) or starts_ros:
             item.add_marker(pytest.mark.ros)

@@ -13,7 +13,7 @@ import sys
 
 import pytest
 
-PACKAGES = ["thorvald_base", "thorvald_bringup", "thorvald_model", "thorvald_sim", "thorvald_teleop"]
+PACKAGES = ["thorvald_base", "thorvald_bringup", "thorvald_design", "thorvald_model", "thorvald_sim", "thorvald_teleop"]
 # The modules whose job is ROS or physics, and why; everything else must be pure.
 NOT_PURE = {
     "thorvald_base.base_driver_node": "a node",
@@ -40,6 +40,7 @@ NOT_PURE = {
     "thorvald_sim.simulation": "the simulator's physics (pybullet)",
     "thorvald_sim.runner": "drives a robot in the simulator without ROS (pybullet)",
     "thorvald_sim.run_robot": "the runner's command line (pybullet)",
+    "thorvald_design.lab": "drives a design study's candidate in the simulator (pybullet)",
 }
 # Modules that import ROS only when a function runs, on purpose; every other module (the base
 # handles among them) imports none even inside a function.
@@ -47,6 +48,7 @@ CALL_TIME_ROS = {
     "thorvald_sim.can_emulator_node": "the emulator runs without ROS too; with a master it offers services",
     "thorvald_bringup.odometry_report_cli": "a command that reads the recorded bag (genpy) after the drive",
     "thorvald_sim.sensor_kinds.model": "the sensor kinds' models call pybullet; their block readers never load it",
+    "thorvald_design.runs": "a study's run (in a worker process) drives its candidate in the simulator",
 }
 FORBIDDEN = ["rospy", "genpy", "pybullet", "thorvald_msgs", "geometry_msgs", "nav_msgs", "sensor_msgs", "tf2_ros"]
 

@@ -1,0 +1,120 @@
+"""``rosrun thorvald_design design_study STUDY.yaml --out DIR [--jobs N] [--resume]``: a design study
+run from the command line.
+
+The study file is read and checked first (every problem with its key path, value and rule; exit 2,
+no traceback). Every candidate's robot file is written to ``DIR/candidates/``; the runs (one a
+candidate and scenario) go to N worker processes (default: the machine's cores), each its own
+pybullet client, a progress bar on the terminal saying which candidate and scenario run; each run's
+result lands in ``DIR/results.json`` as it ends (so nothing is lost to an interruption, and
+``--resume`` skips the runs already there), and at the end ``DIR/results.csv`` and a table on the
+terminal.
+
+No ROS master: the runs use the simulator library's runner.
+"""
+
+import argparse
+import os
+import sys
+import time
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from multiprocessing import get_context
+from typing import List, Optional
+
+from tqdm import tqdm
+
+from thorvald_model.errors import ConfigError
+
+from .report_table import results_table, write_csv
+from .runs import Job, done, empty_results, merge, prepare, read_results, run_one, write_results
+from .study import load_study
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="design_study",
+        description="Compare robot designs in simulation: candidates through scenarios, metrics from ground truth.",
+    )
+    p.add_argument("study", help="the study file (YAML: candidates and scenarios; docs/design-studies.md)")
+    p.add_argument("--out", required=True, metavar="DIR", help="where results.json, results.csv and the rest go")
+    p.add_argument("--jobs", type=int, default=0, metavar="N", help="worker processes (default: the cores)")
+    p.add_argument("--resume", action="store_true", help="keep the results already in DIR; run only the rest")
+    return p
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    args = build_parser().parse_args(argv)
+    if args.jobs < 0:
+        print("design_study: --jobs must be >= 0 (0: the cores)", file=sys.stderr)
+        return 2
+    try:
+        study = load_study(args.study)
+    except ConfigError as e:
+        print(e, file=sys.stderr)
+        return 2
+    os.makedirs(args.out, exist_ok=True)
+    jobs = prepare(study, args.out)
+    results = empty_results(study)
+    old = read_results(args.out) if args.resume else None
+    if old is not None:
+        for name in results["candidates"]:
+            kept = old.get("candidates", {}).get(name, {})
+            for scenario, result in kept.get("scenarios", {}).items():
+                if scenario in dict(study.scenarios):
+                    merge(results, {"candidate": name, "scenario": scenario, "mass_kg": kept.get("mass_kg"),
+                                    "result": result}, study)  # fmt: skip
+    todo = [job for job in jobs if not done(results, job)]
+    write_results(args.out, results)
+    workers = args.jobs or os.cpu_count() or 1
+    skipped = len(jobs) - len(todo)
+    print(
+        f"design_study: {len(study.candidates)} candidates x {len(study.scenarios)} scenarios = {len(jobs)} runs"
+        + (f" ({skipped} already in {args.out})" if skipped else "")
+        + f", {min(workers, max(len(todo), 1))} worker processes",
+        file=sys.stderr,
+    )
+    started = time.monotonic()
+    _run(todo, workers, results, study, args.out)
+    write_results(args.out, results)
+    write_csv(os.path.join(args.out, "results.csv"), results, study)
+    print(results_table(results, study))
+    print(
+        f"design_study: {len(todo)} runs in {time.monotonic() - started:.1f} s; results in {args.out}", file=sys.stderr
+    )
+    failed = [n for n, c in results["candidates"].items() if c["status"] != "ok"]
+    return 1 if failed and len(failed) == len(results["candidates"]) else 0
+
+
+def _run(todo: List[Job], workers: int, results, study, out_dir: str) -> None:
+    if not todo:
+        return
+    bar = tqdm(total=len(todo), unit="run", file=sys.stderr, dynamic_ncols=True, disable=None)
+    try:
+        with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=get_context("spawn")) as pool:
+            pending = {pool.submit(run_one, job): job for job in todo}
+            finished_runs = 0
+            running = list(todo[: min(workers, len(todo))])
+            bar.set_postfix_str(", ".join(j.label for j in running))
+            while pending:
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for future in finished:
+                    job = pending.pop(future)
+                    run = future.result()
+                    merge(results, run, study)
+                    write_results(out_dir, results)
+                    bar.update(1)
+                    finished_runs += 1
+                    if bar.disable:  # no terminal: a line a run
+                        print(
+                            f"[{finished_runs}/{len(todo)}] {job.label}: {_outcome(run)}", file=sys.stderr, flush=True
+                        )
+                    running = [j for j in running if j != job]
+                    waiting = [j for j in pending.values() if j not in running]
+                    running += waiting[: max(0, min(workers, len(pending)) - len(running))]
+                    bar.set_postfix_str(", ".join(j.label for j in running))
+    finally:
+        bar.close()
+
+
+def _outcome(run) -> str:
+    result = run["result"]
+    return result if isinstance(result, str) else "ok"

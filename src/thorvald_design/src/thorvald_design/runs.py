@@ -1,0 +1,168 @@
+"""A study's runs: one (candidate, scenario) a run, each in a worker process of its own pybullet
+client, their results gathered into ``results.json`` as each ends.
+
+:func:`prepare` writes every candidate's robot file into ``DIR/candidates/`` (what its runs load,
+kept so a run can be repeated by hand); :func:`run_one` is what a worker runs: it builds the
+candidate's design and lab and runs the scenario's procedure, and never raises: a candidate that
+cannot be built or spawned, or a scenario that breaks, comes back as ``"failed: why"``.
+
+Not pure: the runs run pybullet.
+"""
+
+import json
+import os
+import traceback
+from dataclasses import dataclass
+from typing import Any, Dict, List, Mapping, Optional, Tuple
+
+import yaml
+
+from thorvald_model.errors import ThorvaldModelError
+from thorvald_sim.errors import ThorvaldSimError
+
+from .scenarios import SCENARIOS
+from .study import Candidate, Study
+
+RESULTS = "results.json"
+
+
+@dataclass(frozen=True)
+class Job:
+    candidate: str
+    robot_file: str  # the candidate's file in DIR/candidates
+    as_built: str
+    seed: int
+    scenario: str
+    params: Tuple[Tuple[str, Any], ...]
+
+    @property
+    def label(self) -> str:
+        return f"{self.candidate}: {self.scenario}"
+
+
+def candidate_file(out_dir: str, candidate: Candidate) -> str:
+    return os.path.join(out_dir, "candidates", safe_name(candidate.name) + ".yaml")
+
+
+def safe_name(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "_-=.," else "_" for c in name)
+
+
+def prepare(study: Study, out_dir: str) -> List[Job]:
+    """Writes each candidate's robot file; the runs, candidate by candidate, scenario by scenario."""
+    os.makedirs(os.path.join(out_dir, "candidates"), exist_ok=True)
+    jobs = []
+    for candidate in study.candidates:
+        path = candidate_file(out_dir, candidate)
+        text = yaml.safe_dump(candidate.robot_data, sort_keys=False, default_flow_style=None)
+        header = f"# {candidate.name}: {candidate.robot_file}"
+        header += "".join(f", {k} = {v:g}" for k, v in candidate.swept)
+        if candidate.payload is not None:
+            header += f", payload {candidate.payload.mass:g} kg"
+        _write_if_changed(path, header + "\n" + text)
+        for scenario, params in study.scenarios:
+            jobs.append(
+                Job(candidate.name, path, candidate.as_built, study.seed, scenario, tuple(sorted(params.items())))
+            )
+    return jobs
+
+
+def _write_if_changed(path: str, text: str) -> None:
+    try:
+        with open(path, encoding="utf-8") as f:
+            if f.read() == text:
+                return
+    except OSError:
+        pass
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
+
+
+def run_one(job: Job) -> Dict[str, Any]:
+    """Runs one job: ``{"candidate", "scenario", "mass_kg", "result"}``, result a mapping of metrics or
+    ``"failed: why"`` (``"build"`` failures: the candidate's own, before any scenario)."""
+    from .design import design_of  # noqa: PLC0415 (the worker's imports: xacro, pybullet)
+    from .lab import Lab  # noqa: PLC0415
+
+    out: Dict[str, Any] = {"candidate": job.candidate, "scenario": job.scenario, "mass_kg": None}
+    try:
+        design = design_of(job.candidate, job.robot_file)
+    except (ThorvaldModelError, ValueError, RuntimeError) as e:
+        out.update(result=f"failed: cannot be built: {_one_line(e)}", build_failed=True)
+        return out
+    out["mass_kg"] = round(design.mass, 3)
+    lab = Lab(job.robot_file, job.as_built, job.seed)
+    try:
+        result = SCENARIOS[job.scenario].procedure(lab, design, dict(job.params))
+    except (ThorvaldModelError, ThorvaldSimError) as e:  # the robot's own: its files, its spawn
+        what = "cannot be spawned" if isinstance(e, ThorvaldSimError) else "cannot be built"
+        out.update(result=f"failed: {what}: {_one_line(e)}", build_failed=True)
+        return out
+    except Exception as e:  # a run must never take the study down: the failure is its result
+        where = traceback.extract_tb(e.__traceback__)[-1]
+        out.update(result=f"failed: broke: {_one_line(e)} ({os.path.basename(where.filename)}:{where.lineno})")
+        return out
+    out["result"] = result
+    return out
+
+
+def _one_line(e: BaseException) -> str:
+    text = str(e).strip().replace("\n", " ")
+    return text or type(e).__name__
+
+
+# ---- results.json -----------------------------------------------------------------------------------
+def empty_results(study: Study) -> Dict[str, Any]:
+    return {
+        "study": {"description": study.description, "seed": study.seed, "scenarios": [s for s, _ in study.scenarios]},
+        "candidates": {
+            c.name: {
+                "status": "pending",
+                "mass_kg": None,
+                "robot": c.robot_file,
+                "swept": {k: v for k, v in c.swept},
+                "payload_kg": c.payload.mass if c.payload else 0.0,
+                "scenarios": {},
+            }
+            for c in study.candidates
+        },
+    }
+
+
+def merge(results: Dict[str, Any], run: Mapping[str, Any], study: Study) -> None:
+    """Puts one run's result in its candidate's entry and updates the candidate's status."""
+    entry = results["candidates"][run["candidate"]]
+    if run["mass_kg"] is not None:
+        entry["mass_kg"] = run["mass_kg"]
+    entry["scenarios"][run["scenario"]] = run["result"]
+    order = [s for s, _ in study.scenarios]
+    entry["scenarios"] = {s: entry["scenarios"][s] for s in order if s in entry["scenarios"]}
+    failures = [(s, r) for s, r in entry["scenarios"].items() if isinstance(r, str) and r.startswith("failed")]
+    if failures:
+        scenario, reason = failures[0]
+        entry["status"] = reason if run.get("build_failed") else f"failed: {scenario}: {reason[len('failed: ') :]}"
+    elif len(entry["scenarios"]) == len(order):
+        entry["status"] = "ok"
+
+
+def done(results: Mapping[str, Any], job: Job) -> bool:
+    """Whether results already hold the job's result (--resume)."""
+    entry = results.get("candidates", {}).get(job.candidate)
+    return bool(entry) and job.scenario in entry.get("scenarios", {})
+
+
+def read_results(out_dir: str) -> Optional[Dict[str, Any]]:
+    try:
+        with open(os.path.join(out_dir, RESULTS), encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def write_results(out_dir: str, results: Mapping[str, Any]) -> None:
+    """results.json, written whole to a new file then moved over the old (a reader never sees half)."""
+    path = os.path.join(out_dir, RESULTS)
+    with open(path + ".part", "w", encoding="utf-8") as f:
+        json.dump(results, f, indent=2, sort_keys=False)
+        f.write("\n")
+    os.replace(path + ".part", path)

@@ -1,0 +1,87 @@
+"""drawbar: the largest pull the robot holds at walking speed (the Thorvald II hardware paper's
+traction trial).
+
+Procedure: on level ground of the study's surface the robot drives straight ahead at ``speed``
+[m/s] (its heading held); after ``settle`` [s] a horizontal pull backwards acts on the frame at
+``hitch_height`` [m] above the ground behind base_link, growing by ``step_n`` [N] every ``hold_s``
+[s]. A pull is held when the robot's mean speed over the last second of its step is at least
+``held_speed`` (90 % by default) of the command. ``max_pull_n`` is the largest held: past it the
+driven wheels slip (traction) or their motors are at their torque limit (motor torque), as
+``limited_by`` says (the motors' mean share of their limit over that last second, as
+:mod:`~thorvald_design.scenarios.gradeability` decides it).
+
+What it must agree with: at constant speed on level ground the driven wheels' forces balance the
+pull and the rolling resistance: sum_driven min(mu N_i, F_i) = P + C_rr W, the loads N_i shifted
+rearwards by the pull's moment P h about the contacts
+(:func:`thorvald_design.quasi_static.max_pull`), reported as ``predicted_pull_n``.
+"""
+
+import math
+from typing import Any, Dict, List, Mapping
+
+from thorvald_model.schema import Key, one_of
+
+from .driving import SURFACE_RULE, SURFACES, flat_world, heading_hold, mean
+from .gradeability import TORQUE_BOUND
+from .kind import ScenarioKind
+
+KEYS = (
+    Key("surface", str, "grass", check=one_of(*SURFACES), rule=SURFACE_RULE),
+    Key("speed", float, 1.0, check=lambda v: 0.05 <= v <= 3.0, rule="must be in [0.05, 3] [m/s]"),
+    Key("hitch_height", float, 0.4, check=lambda v: 0.0 <= v <= 3.0, rule="must be in [0, 3] [m]"),
+    Key("step_n", float, 50.0, check=lambda v: 1.0 <= v <= 10000.0, rule="must be in [1, 10000] [N]"),
+    Key("hold_s", float, 2.0, check=lambda v: 0.5 <= v <= 30.0, rule="must be in [0.5, 30] [s]"),
+    Key("settle", float, 3.0, check=lambda v: 0.5 <= v <= 30.0, rule="must be in [0.5, 30] [s]"),
+    Key("held_speed", float, 0.9, check=lambda v: 0.1 <= v < 1.0, rule="must be in [0.1, 1)"),
+)
+RESULTS = ("max_pull_n", "limited_by", "predicted_pull_n")
+MAX_STEPS = 400  # of the pull: a robot holding 400 steps is out of the scenario's range
+
+
+def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
+    surface, speed = params["surface"], params["speed"]
+    predicted = design.pull_limit(surface, params["hitch_height"])
+    held, limited_by = 0.0, f"none up to {MAX_STEPS * params['step_n']:g} N"
+    loads: List[tuple] = []
+    with lab.session(flat_world(surface)) as session:
+        command = heading_hold(session, 0.0, speed)
+        session.run(params["settle"], command)
+        for k in range(1, MAX_STEPS + 1):
+            pull = k * params["step_n"]
+            # backwards along the robot's heading, at the hitch behind base_link
+            yaw = session.track[-1].yaw
+            session.push(
+                (-pull * math.cos(yaw), -pull * math.sin(yaw), 0.0), (-design.rear, 0.0, params["hitch_height"])
+            )
+            start = session.time
+            loads.clear()
+
+            def stop(s) -> bool:
+                loads.append((s.time, [abs(m.wheel_torque) for m in s.motor_loads()]))
+                return False
+
+            session.run(start + params["hold_s"], command, stop)
+            last = [q for q in session.track if q.t >= session.time - 1.0]
+            v = math.hypot(last[-1].x - last[0].x, last[-1].y - last[0].y) / max(last[-1].t - last[0].t, 1e-9)
+            if v < params["held_speed"] * speed:
+                torques = [tq for t, tq in loads if t >= session.time - 1.0]
+                share = mean([mean([a / m for a, m in zip(tq, design.max_wheel_torques) if m > 0]) for tq in torques])
+                limited_by = "motor torque" if share >= TORQUE_BOUND else "traction"
+                break
+            held = pull
+    return {
+        "max_pull_n": held,
+        "limited_by": limited_by,
+        "predicted_pull_n": round(predicted.pull, 1),
+        "predicted_limited_by": predicted.limited_by,
+        "surface": surface,
+    }
+
+
+DRAWBAR = ScenarioKind(
+    name="drawbar",
+    what="the largest pull held at walking speed on a surface, and what limited it",
+    keys=KEYS,
+    results=RESULTS,
+    procedure=procedure,
+)

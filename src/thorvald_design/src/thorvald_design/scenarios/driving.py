@@ -1,0 +1,108 @@
+"""What the scenarios share: the worlds they write (a ground of a surface kind, a ramp, a step) and the
+rules that end a drive (reached, stalled, slid back, tipped).
+
+Pure: numbers and world-file contents (mappings), no simulator.
+"""
+
+import math
+from dataclasses import dataclass
+from typing import Dict, Optional, Sequence, Tuple
+
+from thorvald_sim.world.values import SURFACE_KINDS
+
+from .kind import Pose
+
+SURFACES = tuple(SURFACE_KINDS)
+SURFACE_RULE = "must be one of " + ", ".join(SURFACES)
+STALL_WINDOW = 2.0  # [s]: a drive that gains less than STALL_PROGRESS in this long has stalled
+STALL_PROGRESS = 0.03  # [m]
+SLID_BACK = 0.10  # [m] back from the furthest point reached: sliding, not stopping
+TIPPED = math.radians(25.0)  # rolled or pitched this far beyond the ground's own slope: it has gone over
+
+
+def surface_keys(kind: str) -> Dict[str, float]:
+    """A surface kind's contact numbers as a ground's or an element's keys (the world file's)."""
+    surface = SURFACE_KINDS[kind]
+    return {"lateral_friction": surface.lateral_friction, "rolling_friction": surface.rolling_friction}
+
+
+def flat_world(surface: str, description: str = "") -> Dict:
+    return {"description": description, "ground": {"surface": surface}}
+
+
+def ramp_world(surface: str, angle: float, run: float, top: float, width: float = 10.0) -> Dict:
+    """A hill along +x whose foot is at x = 0: it climbs at angle [rad] over a horizontal run [m], stays
+    level for top [m] and comes down the same way; its faces and the ground are of the surface kind
+    (a ramp is rigid: the kind's friction and rolling resistance, not its sinkage)."""
+    footprint = 2.0 * run + top
+    return {
+        "description": f"a {math.degrees(angle):.1f} degree ramp of {surface}",
+        "ground": {"surface": surface},
+        "slopes": {
+            "slope0": {
+                "x": footprint / 2.0, "y": 0.0, "yaw": 0.0, "width": width, "angle": angle,
+                "height": run * math.tan(angle), "top_length": top, **surface_keys(surface),
+            }
+        },
+    }  # fmt: skip
+
+
+@dataclass
+class Progress:
+    """Watches a drive along a direction (unit vector (ux, uy)): how far it got, whether it stalled,
+    slid back or tipped over a ground sloping at ``slope`` [rad]."""
+
+    ux: float = 1.0
+    uy: float = 0.0
+    slope: float = 0.0
+    start: Optional[Pose] = None
+    furthest: float = 0.0
+    outcome: str = ""  # "", "stalled", "slid back", "tipping"
+
+    def along(self, pose: Pose) -> float:
+        if self.start is None:
+            self.start = pose
+        return (pose.x - self.start.x) * self.ux + (pose.y - self.start.y) * self.uy
+
+    def failed(self, track: Sequence[Pose]) -> bool:
+        """Whether the drive so far has failed (outcome says how)."""
+        pose = track[-1]
+        s = self.along(pose)
+        self.furthest = max(self.furthest, s)
+        if max(abs(pose.roll), abs(pose.pitch)) > abs(self.slope) + TIPPED:
+            self.outcome = "tipping"
+        elif s < self.furthest - SLID_BACK:
+            self.outcome = "slid back"
+        elif pose.t - track[0].t > STALL_WINDOW + 1.0:
+            earlier = at_time(track, pose.t - STALL_WINDOW)
+            if s - self.along(earlier) < STALL_PROGRESS:
+                self.outcome = "stalled"
+        return bool(self.outcome)
+
+
+def at_time(track: Sequence[Pose], t: float) -> Pose:
+    """The last pose at or before t (the first if none)."""
+    lo, hi = 0, len(track) - 1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if track[mid].t <= t:
+            lo = mid
+        else:
+            hi = mid - 1
+    return track[lo]
+
+
+def heading_hold(session, heading: float, speed: float, gain: float = 1.5, max_rate: float = 0.5):
+    """A command (of t, for the session's run) that drives at speed [m/s] holding heading [rad] (yaw):
+    the yaw error of the session's last pose fed back to the turn rate (a P controller, rate limited)."""
+
+    def command(t: float) -> Tuple[float, float, float]:
+        yaw = session.track[-1].yaw if session.track else heading
+        error = math.atan2(math.sin(heading - yaw), math.cos(heading - yaw))
+        return (speed, 0.0, max(-max_rate, min(max_rate, gain * error)))
+
+    return command
+
+
+def mean(values: Sequence[float]) -> float:
+    return sum(values) / len(values) if values else 0.0

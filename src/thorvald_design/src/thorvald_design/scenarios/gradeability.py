@@ -1,0 +1,191 @@
+"""gradeability: how steep a ramp the robot climbs, and descends under control.
+
+Procedure: ramps of increasing angle (``start_deg``, then every ``step_deg`` up to ``max_deg``), each
+a hill of the study's surface whose foot is 0.5 m ahead of the robot's front, climbing over
+``ramp_length`` [m] of run (at least twice the robot's length and 1 m) to a level top. The robot is
+commanded straight ahead at ``speed`` [m/s] (its own base_driver core, the heading held). A climb
+succeeds when base_link is on the top; it fails when the robot stalls (less than 3 cm gained in
+2 s), slides back (10 cm back from the furthest point it reached), tips (rolled or pitched 25
+degrees more than the ramp), or runs out of time (twice the time the climb takes at speed, and
+10 s). The series stops at the first failure: ``max_climb_deg`` is the steepest climbed,
+``limited_by`` what stopped the next:
+
+- ``tipping`` when it tipped;
+- ``motor torque`` when the driven wheels' motors were at their torque limit (on average over the
+  last second at least 95 % of it): they cannot turn the wheels any harder, the wheels do not slip;
+- ``traction`` otherwise: the wheels turn below their torque limit, so the ground gives no more
+  grip: they slip.
+
+Descent: from the level top of each ramp the robot drives down the far side at ``speed``; it is
+under control when its speed along the ramp stays within ``max(0.1, 0.3 * speed)`` m/s of the
+command (the driven wheels hold it back without sliding) and it does not tip.
+``max_descent_deg`` is the steepest descended under control.
+
+What the metric means, and what it must agree with: climbing at constant speed, the driven wheels
+push the robot up with the forces the ground lets them have (at most mu N_i each, N_i the wheel's
+load, which the grade shifts towards the downhill wheels) and the motors give (at most their torque
+limit over the wheel radius), against the weight's component along the ramp and the rolling
+resistance of every wheel: sum_driven min(mu N_i, F_i) >= W sin(theta) + C_rr W cos(theta). The
+steepest theta that holds is the quasi-static limit (:func:`thorvald_design.quasi_static.gradeability`),
+reported beside the measured one as ``predicted_climb_deg`` and ``predicted_limited_by``; the
+simulated climb, a dynamic drive at speed, reaches it to within a step.
+"""
+
+import math
+from typing import Any, Dict, List, Mapping
+
+from thorvald_model.errors import Problem
+from thorvald_model.schema import Key, one_of
+
+from .driving import SURFACE_RULE, SURFACES, TIPPED, Progress, at_time, heading_hold, mean, ramp_world
+from .kind import ScenarioKind
+
+TORQUE_BOUND = 0.95  # of the motors' torque limit, on average over the last second: the motors are the limit
+SPEED_WINDOW = 0.5  # [s] a descent's speed is measured over
+SETTLE = 1.0  # [s] the robot stands before it is commanded (it settles on its suspension)
+
+KEYS = (
+    Key("surface", str, "tarmac", check=one_of(*SURFACES), rule=SURFACE_RULE),
+    Key("speed", float, 0.5, check=lambda v: 0.05 <= v <= 3.0, rule="must be in [0.05, 3] [m/s]"),
+    Key("start_deg", float, 4.0, check=lambda v: 0.5 <= v <= 60.0, rule="must be in [0.5, 60] [deg]"),
+    Key("step_deg", float, 2.0, check=lambda v: 0.25 <= v <= 20.0, rule="must be in [0.25, 20] [deg]"),
+    Key("max_deg", float, 40.0, check=lambda v: 0.5 <= v <= 60.0, rule="must be in [0.5, 60] [deg]"),
+    Key("ramp_length", float, 3.0, check=lambda v: 0.5 <= v <= 30.0, rule="must be in [0.5, 30] [m] of run"),
+    Key("descent", bool, True),
+)
+RESULTS = (
+    "surface",
+    "max_climb_deg",
+    "limited_by",
+    "max_descent_deg",
+    "predicted_climb_deg",
+    "predicted_limited_by",
+    "predicted_descent_deg",
+)
+
+
+def check(values: Mapping[str, Any], path: str, problems: List[Problem]) -> None:
+    if values["max_deg"] < values["start_deg"]:
+        problems.append(
+            Problem(f"{path}.max_deg", values["max_deg"], f"must be >= start_deg ({values['start_deg']:g})")
+        )
+
+
+def angles(params: Mapping[str, Any]) -> List[float]:
+    """The ramps' angles [deg] in the order they are tried."""
+    out, k = [], 0
+    while True:
+        a = round(params["start_deg"] + k * params["step_deg"], 6)
+        if a > params["max_deg"] + 1e-9:
+            return out
+        out.append(a)
+        k += 1
+
+
+def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
+    surface = params["surface"]
+    limits = design.grade_limits(surface)
+    result: Dict[str, Any] = {
+        "surface": surface,
+        "predicted_climb_deg": round(math.degrees(limits.climb), 2),
+        "predicted_limited_by": limits.limited_by,
+        "predicted_descent_deg": round(math.degrees(limits.descent), 2),
+    }
+    climbed, limited_by, tries = 0.0, f"none up to {params['max_deg']:g} deg", []
+    for angle in angles(params):
+        outcome = _climb(lab, design, params, math.radians(angle))
+        tries.append([angle, outcome])
+        if outcome != "ok":
+            limited_by = outcome
+            break
+        climbed = angle
+    result.update(max_climb_deg=climbed, limited_by=limited_by, climbs=tries)
+    descended, tries = 0.0, []
+    if params["descent"]:
+        for angle in angles(params):
+            outcome = _descend(lab, design, params, math.radians(angle))
+            tries.append([angle, outcome])
+            if outcome != "ok":
+                break
+            descended = angle
+    result.update(max_descent_deg=descended if params["descent"] else "n/a: descent: false", descents=tries)
+    return result
+
+
+def ramp_run(design, params) -> float:
+    """[m] of the ramp's run: ``ramp_length``, or twice the robot's length and 1 m if that is longer,
+    so that the robot stands wholly on the incline for a while (a robot bridging the foot and the
+    crest stands on neither)."""
+    return max(params["ramp_length"], 2.0 * design.length + 1.0)
+
+
+def _climb(lab, design, params, angle: float) -> str:
+    run, speed = ramp_run(design, params), params["speed"]
+    top = design.length + 1.0
+    world = ramp_world(params["surface"], angle, run, top)
+    start_x = -(design.front + 0.5)  # the robot's front 0.5 m short of the foot
+    goal = run + 0.5 * top  # base_link over the middle of the top
+    limit = SETTLE + 2.0 * (goal - start_x) / speed + 10.0
+    progress = Progress(slope=angle)
+    loads: List[tuple] = []
+    with lab.session(world, x=start_x) as session:
+        session.run(SETTLE, lambda t: (0.0, 0.0, 0.0))
+        command = heading_hold(session, 0.0, speed)
+
+        def stop(s) -> bool:
+            loads.append((s.time, [abs(m.wheel_torque) for m in s.motor_loads()]))
+            return s.track[-1].x >= goal or progress.failed(s.track)
+
+        session.run(limit, command, stop)
+        pose = session.track[-1]
+    if pose.x >= goal:
+        return "ok"
+    if progress.outcome == "tipping":
+        return "tipping"
+    # what held it: the motors at their limit, or the ground's grip (the wheels turn below it)
+    last = [torques for t, torques in loads if t >= loads[-1][0] - 1.0]
+    share = mean([mean([tq / m for tq, m in zip(torques, design.max_wheel_torques) if m > 0]) for torques in last])
+    return "motor torque" if share >= TORQUE_BOUND else "traction"
+
+
+def _descend(lab, design, params, angle: float) -> str:
+    run, speed = ramp_run(design, params), params["speed"]
+    top = design.length + 1.0
+    world = ramp_world(params["surface"], angle, run, top)
+    height = run * math.tan(angle)
+    start_x = run + 0.5 * top  # base_link over the middle of the top
+    far_foot = 2.0 * run + top
+    goal = far_foot + design.length  # off the ramp, on level ground again
+    limit = SETTLE + 2.0 * (goal - start_x) / speed + 10.0
+    tolerance = max(0.1, 0.3 * speed)
+    outcome = []
+    with lab.session(world, x=start_x, z=height) as session:
+        session.run(SETTLE, lambda t: (0.0, 0.0, 0.0))
+        command = heading_hold(session, 0.0, speed)
+
+        def stop(s) -> bool:
+            pose = s.track[-1]
+            if max(abs(pose.roll), abs(pose.pitch)) > angle + TIPPED:
+                outcome.append("tipping")
+            elif run + top + 0.5 * design.length < pose.x < far_foot:  # on the ramp
+                before = at_time(s.track, pose.t - SPEED_WINDOW)
+                v = math.hypot(pose.x - before.x, pose.y - before.y) / max(pose.t - before.t, 1e-9)
+                if abs(v - speed) > tolerance:
+                    outcome.append(f"ran away ({v:.2f} m/s for {speed:g})" if v > speed else "stalled")
+            return bool(outcome) or pose.x >= goal
+
+        session.run(limit, command, stop)
+        reached = session.track[-1].x >= goal
+    if outcome:
+        return outcome[0]
+    return "ok" if reached else "stalled"
+
+
+GRADEABILITY = ScenarioKind(
+    name="gradeability",
+    what="the steepest ramp climbed, what limited it, and the steepest descended under control",
+    keys=KEYS,
+    results=RESULTS,
+    procedure=procedure,
+    check=check,
+)

@@ -1,0 +1,83 @@
+"""What a scenario is: :class:`ScenarioKind`, one entry of the registry
+(:mod:`thorvald_design.scenarios`), and what its procedure is given.
+
+A scenario is a documented procedure with its metrics: its parameters (keys of the study file's
+``scenarios.NAME`` with defaults and rules, checked as a robot file's keys are), the procedure that
+drives a candidate through it and measures the metrics from ground truth, and the names of the
+metrics it reports. The procedure is pure: it drives through a :class:`Lab`, which the study's
+worker makes (a simulation of the candidate's own, :mod:`thorvald_design.lab`), so a scenario module
+imports neither pybullet nor ROS and its arithmetic is tested on its own.
+"""
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, ContextManager, Dict, List, Mapping, Optional, Protocol, Sequence, Tuple
+
+from thorvald_model.errors import Problem
+from thorvald_model.schema import Key
+
+Twist = Tuple[float, float, float]  # vx [m/s], vy [m/s], wz [rad/s] in base_link
+
+
+@dataclass(frozen=True)
+class Pose:
+    """base_link in the world at a control instant."""
+
+    t: float  # [s]
+    x: float  # [m]
+    y: float
+    z: float
+    roll: float  # [rad]
+    pitch: float  # nose up positive
+    yaw: float
+
+
+class Session(Protocol):
+    """One drive of a candidate in a world of the scenario's (see :class:`thorvald_design.lab.LabSession`)."""
+
+    track: List[Pose]  # base_link at every control instant so far
+
+    @property
+    def time(self) -> float: ...
+
+    def run(
+        self,
+        until: float,
+        command: Callable[[float], Optional[Twist]],
+        stop: Optional[Callable[["Session"], bool]] = None,
+    ) -> bool: ...
+
+    def pose(self) -> Pose: ...
+
+    def motor_loads(self) -> List[Any]: ...  # per drive: wheel_torque, wheel_rate, steering_torque, steering_rate
+
+    def push(self, force: Optional[Sequence[float]], at: Sequence[float] = (0.0, 0.0, 0.0)) -> None: ...
+
+
+class Lab(Protocol):
+    def session(
+        self, world: Mapping, *, x: float = 0.0, y: float = 0.0, z: float = 0.0, yaw: float = 0.0, roll: float = 0.0
+    ) -> Any:
+        """A session (a context manager giving a :class:`Session`) of the candidate spawned at (x, y, z, yaw)
+        in the world of the given world-file contents."""
+        ...
+
+
+@dataclass(frozen=True)
+class ScenarioKind:
+    """A kind of scenario: one entry of the registry."""
+
+    name: str  # its key under ``scenarios:``
+    what: str  # one line: what it measures
+    keys: Tuple[Key, ...]  # its parameters
+    results: Tuple[str, ...]  # the metrics it reports (results.json's keys, in order)
+    # procedure(lab, design, params) -> {metric: value}; a metric it cannot give is "n/a: why"
+    procedure: Callable[[Lab, Any, Mapping[str, Any]], Dict[str, Any]]
+    # the rules between its parameters: problems appended at path.KEY
+    check: Callable[[Mapping[str, Any], str, List[Problem]], None] = field(default=lambda values, path, problems: None)
+
+
+def not_applicable(why: str) -> str:
+    return f"n/a: {why}"
+
+
+ContextSession = ContextManager[Session]

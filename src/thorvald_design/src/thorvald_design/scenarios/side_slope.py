@@ -1,0 +1,154 @@
+"""side_slope: across slopes of increasing angle, holding a heading: how far the robot drifts
+downhill per metre, the steepest it holds, and its static overturning angle.
+
+Procedure: for each angle (``start_deg``, then every ``step_deg`` up to ``max_deg``) a hill of the
+study's surface whose face rises towards +y; the robot is set down on the middle of the face, heading
++x (along the contour, its left side uphill), and commanded ``speed`` [m/s] for ``distance`` [m],
+its heading held by feeding the yaw error back to the turn rate (a driver's steering correction).
+From ground truth:
+
+- ``drift_per_m`` (at each angle; the value reported is the steepest held's): the downhill
+  displacement perpendicular to the heading at the end of the traverse over the distance along it
+  (:func:`thorvald_design.metrics.lateral_drift`): the sideways slip of the tyres the slope's
+  downhill pull causes, which a robot holding its heading cannot correct (0: the wheels do not slip
+  sideways; tan of the crab angle it slides at otherwise);
+- a traverse is held when the robot covers the distance, does not tip, and drifts at most
+  ``max_drift`` [m per m] downhill; ``max_traverse_deg`` is the steepest held.
+
+``static_overturning_deg`` is ISO 16231-2's static overturning angle to the side, from the centre of
+mass and the wheel contacts, not from the drive: the tilt about the support polygon's side edge (the
+line through the downhill wheels' contacts) at which the vertical through the centre of mass passes
+over that edge, atan(d / h), d the horizontal distance from the centre of mass to the edge and h its
+height above the ground (:func:`thorvald_design.quasi_static.overturning_angles`); the smaller of the
+two sides. No robot should be driven near it: slip comes first on any real surface.
+"""
+
+import math
+from typing import Any, Dict, List, Mapping
+
+import numpy as np
+
+from thorvald_model.errors import Problem
+from thorvald_model.schema import Key, one_of
+
+from ..metrics import Track, lateral_drift
+from .driving import SURFACE_RULE, SURFACES, Progress, heading_hold, surface_keys
+from .gradeability import SETTLE, angles
+from .kind import ScenarioKind
+
+KEYS = (
+    Key("surface", str, "grass", check=one_of(*SURFACES), rule=SURFACE_RULE),
+    Key("speed", float, 0.5, check=lambda v: 0.05 <= v <= 3.0, rule="must be in [0.05, 3] [m/s]"),
+    Key("start_deg", float, 5.0, check=lambda v: 0.5 <= v <= 60.0, rule="must be in [0.5, 60] [deg]"),
+    Key("step_deg", float, 5.0, check=lambda v: 0.25 <= v <= 20.0, rule="must be in [0.25, 20] [deg]"),
+    Key("max_deg", float, 35.0, check=lambda v: 0.5 <= v <= 60.0, rule="must be in [0.5, 60] [deg]"),
+    Key("distance", float, 5.0, check=lambda v: 1.0 <= v <= 100.0, rule="must be in [1, 100] [m]"),
+    Key("max_drift", float, 0.05, check=lambda v: 0.0 < v <= 1.0, rule="must be in (0, 1] [m per m]"),
+)
+RESULTS = ("max_traverse_deg", "static_overturning_deg", "drift_per_m")
+
+
+def check(values: Mapping[str, Any], path: str, problems: List[Problem]) -> None:
+    if values["max_deg"] < values["start_deg"]:
+        problems.append(
+            Problem(f"{path}.max_deg", values["max_deg"], f"must be >= start_deg ({values['start_deg']:g})")
+        )
+
+
+def side_slope_world(surface: str, angle: float, run: float, length: float) -> Dict:
+    """A hill whose face rises towards +y from its foot at y = 0 over a horizontal run [m], length [m]
+    along x (centred on x = 0), a level top as wide as the run, of the surface kind."""
+    top = run
+    footprint = 2.0 * run + top
+    return {
+        "description": f"a {math.degrees(angle):.1f} degree side slope of {surface}",
+        "ground": {"surface": surface},
+        "slopes": {
+            "slope0": {
+                "x": 0.0, "y": footprint / 2.0, "yaw": math.pi / 2.0, "width": length, "angle": angle,
+                "height": run * math.tan(angle), "top_length": top, **surface_keys(surface),
+            }
+        },
+    }  # fmt: skip
+
+
+def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
+    overturning = design.overturning()
+    result: Dict[str, Any] = {
+        "static_overturning_deg": _deg(overturning.lateral),
+        "static_overturning_left_deg": _deg(overturning.left),
+        "static_overturning_right_deg": _deg(overturning.right),
+    }
+    held, drift, tries = 0.0, None, []
+    for angle in angles(params):
+        # both ways: the left side uphill (heading +x), then the right (heading -x)
+        outcomes = [_traverse(lab, design, params, math.radians(angle), way) for way in (1.0, -1.0)]
+        tries.append([angle, *[[outcome, None if d is None else _rounded(d)] for outcome, d in outcomes]])
+        failed = [outcome for outcome, _ in outcomes if outcome != "ok"]
+        if failed:
+            break
+        held, drift = angle, max(d for _, d in outcomes)
+    result.update(
+        max_traverse_deg=held,
+        drift_per_m=_rounded(drift) if drift is not None else "n/a: no slope held",
+        traverses=tries,
+    )
+    return result
+
+
+def _deg(angle: float) -> float:
+    return round(math.degrees(angle), 2)
+
+
+def _rounded(value: float) -> float:
+    return round(value, 4) + 0.0  # no -0.0
+
+
+def _traverse(lab, design, params, angle: float, way: float):
+    """One traverse (way +1: heading +x, the left side uphill; -1: heading -x): its outcome and the
+    downhill drift per metre."""
+    speed, distance = params["speed"], params["distance"]
+    run = max(4.0, design.width + 2.0)
+    length = distance + design.length + 6.0
+    world = side_slope_world(params["surface"], angle, run, length)
+    y = run / 2.0
+    start_x = way * (-length / 2.0 + design.rear + 1.0)
+    z = y * math.tan(angle) + 0.01
+    heading = 0.0 if way > 0 else math.pi
+    progress = Progress(ux=way, slope=angle)
+    limit = SETTLE + 2.0 * distance / speed + 10.0
+    with lab.session(world, x=start_x, y=y, z=z, yaw=heading, roll=way * angle) as session:
+        session.run(SETTLE, lambda t: (0.0, 0.0, 0.0))
+        first = len(session.track)
+        command = heading_hold(session, heading, speed)
+
+        def stop(s) -> bool:
+            return way * (s.track[-1].x - s.track[first].x) >= distance or progress.failed(s.track[first:])
+
+        session.run(limit, command, stop)
+        poses = session.track[first:]
+    if progress.outcome:
+        return progress.outcome, None
+    if way * (poses[-1].x - poses[0].x) < distance:
+        return "ran out of time", None
+    track = Track(
+        t=np.array([q.t for q in poses]),
+        x=np.array([q.x for q in poses]),
+        y=np.array([q.y for q in poses]),
+        yaw=np.array([q.yaw for q in poses]),
+    )
+    # the face rises to +y: downhill is to the right of heading +x, to the left of heading -x
+    downhill = -way * lateral_drift(track, heading).per_m
+    if downhill > params["max_drift"]:
+        return f"drifted {downhill:.3f} m per m", downhill
+    return "ok", downhill
+
+
+SIDE_SLOPE = ScenarioKind(
+    name="side_slope",
+    what="across slopes holding a heading: drift per metre, the steepest held, the static overturning angle",
+    keys=KEYS,
+    results=RESULTS,
+    procedure=procedure,
+    check=check,
+)

@@ -1,0 +1,181 @@
+"""rosrun thorvald_design design_study, end to end: two candidates through every scenario, the results
+checked against the quasi-static limits and the closed forms, and repeated to the byte."""
+
+import csv
+import json
+import math
+import os
+import shutil
+import subprocess
+
+import pytest
+
+from thorvald_design.design import design_of
+from thorvald_model.description import package_file
+
+STUDY = """\
+description: "two robots, every scenario, short"
+seed: 3
+candidates:
+  std: {robot: thorvald_ii_4wd4ws_std}
+  fwd: {robot: thorvald_ii_1wd1ws_fwd}
+scenarios:
+  gradeability: {surface: grass, start_deg: 6, step_deg: 4, max_deg: 34}
+  side_slope: {surface: grass, start_deg: 10, step_deg: 10, max_deg: 30, distance: 3}
+  turning: {settle: 2}
+  drawbar: {surface: grass, step_n: 100, hold_s: 1.5}
+"""
+KEYS = {
+    "gradeability": {"surface", "max_climb_deg", "limited_by", "max_descent_deg"},
+    "side_slope": {"max_traverse_deg", "static_overturning_deg", "drift_per_m"},
+    "turning": {"turning_diameter_m", "clearance_diameter_m"},
+    "drawbar": {"max_pull_n"},
+}
+
+
+def design_study(*args, timeout=600):
+    return subprocess.run(
+        ["rosrun", "thorvald_design", "design_study", *args], capture_output=True, text=True, timeout=timeout
+    )
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    """The study run twice into two folders: (the first's results, its folder, the second's folder)."""
+    root = tmp_path_factory.mktemp("study")
+    path = root / "study.yaml"
+    path.write_text(STUDY)
+    runs = []
+    for name in ("first", "second"):
+        done = design_study(str(path), "--out", str(root / name), "--jobs", "2")
+        assert done.returncode == 0, done.stderr[-3000:]
+        runs.append(root / name)
+    with open(runs[0] / "results.json", encoding="utf-8") as f:
+        return json.load(f), runs[0], runs[1], done
+
+
+def example(name):
+    return design_of(name, package_file("config", name, name + ".yaml"))
+
+
+@pytest.mark.slow  # two studies of 8 runs each, in worker processes
+def test_every_candidate_has_every_scenarios_metrics(study):
+    results, first, _, done = study
+    assert set(results["candidates"]) == {"std", "fwd"}
+    for name, entry in results["candidates"].items():
+        assert entry["status"] == "ok", (name, entry["status"])
+        robot = {"std": "thorvald_ii_4wd4ws_std", "fwd": "thorvald_ii_1wd1ws_fwd"}[name]
+        assert entry["mass_kg"] == pytest.approx(example(robot).mass, abs=1e-3)
+        for scenario, keys in KEYS.items():
+            assert keys <= set(entry["scenarios"][scenario]), (name, scenario)
+    with open(first / "results.csv", newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["candidate"] for r in rows] == ["std", "fwd"]
+    assert (
+        float(rows[0]["gradeability.max_climb_deg"])
+        == results["candidates"]["std"]["scenarios"]["gradeability"]["max_climb_deg"]
+    )
+    assert "gradeability.max_climb_deg" in done.stdout and "[8/8]" in done.stderr  # the table, the progress
+
+
+@pytest.mark.slow
+def test_the_climbs_agree_with_the_quasi_static_limits(study):
+    """The steepest ramp climbed (a lower bound, a step below the first failed) brackets the quasi-static
+    limit the weight distribution, grip and motors give, to 2 degrees."""
+    results = study[0]
+    for name in ("std", "fwd"):
+        grade = results["candidates"][name]["scenarios"]["gradeability"]
+        climbed, failed = grade["max_climb_deg"], grade["climbs"][-1][0]
+        assert grade["climbs"][-1][1] != "ok"
+        assert climbed - 2.0 <= grade["predicted_climb_deg"] <= failed + 2.0, (name, grade)
+        assert grade["limited_by"] == grade["predicted_limited_by"] == "traction", (name, grade)
+    # all-wheel drive climbs further than front-wheel drive, as the hardware paper's incline trial found
+    std = results["candidates"]["std"]["scenarios"]["gradeability"]
+    fwd = results["candidates"]["fwd"]["scenarios"]["gradeability"]
+    assert std["max_climb_deg"] >= fwd["max_climb_deg"] + 8.0
+
+
+@pytest.mark.slow
+def test_the_pull_agrees_with_the_quasi_static_limit(study):
+    for name in ("std", "fwd"):
+        pull = study[0]["candidates"][name]["scenarios"]["drawbar"]
+        assert pull["max_pull_n"] <= pull["predicted_pull_n"] * 1.1 + 1.0, (name, pull)
+        assert pull["max_pull_n"] + 100.0 >= pull["predicted_pull_n"] * 0.9, (name, pull)
+
+
+@pytest.mark.slow
+def test_turning_diameters_are_the_closed_forms(study):
+    """std spins on the spot: its outermost contact is a corner wheel, hypot(0.547, 0.30) from the centre;
+    fwd turns about its rear axle's middle, 0.9 m behind its front wheel."""
+    results = study[0]
+    std = results["candidates"]["std"]["scenarios"]["turning"]
+    fwd = results["candidates"]["fwd"]["scenarios"]["turning"]
+    assert std["turn"] == "spin" and fwd["turn"] == "about the axle line"
+    assert std["turning_diameter_m"] == pytest.approx(2.0 * math.hypot(0.547, 0.30), abs=0.03)
+    assert fwd["turning_diameter_m"] == pytest.approx(1.8, abs=0.03)
+    for turn in (std, fwd):
+        assert turn["clearance_diameter_m"] > turn["turning_diameter_m"]
+
+
+@pytest.mark.slow
+def test_side_slopes_are_held_only_below_the_static_overturning_angle(study):
+    results = study[0]
+    for name in ("std", "fwd"):
+        side = results["candidates"][name]["scenarios"]["side_slope"]
+        assert side["max_traverse_deg"] <= side["static_overturning_deg"] + 15.0
+        held = [t for t in side["traverses"] if all(way[0] == "ok" for way in t[1:])]
+        assert all(t[0] <= side["max_traverse_deg"] for t in held)
+    fwd = results["candidates"]["fwd"]["scenarios"]["side_slope"]
+    # the tricycle's battery side is its weak side: 5.7 degrees, and its traverse with that side downhill tips
+    assert fwd["static_overturning_deg"] == pytest.approx(5.72, abs=0.1)
+    assert fwd["traverses"][0][2][0] == "tipping"
+
+
+@pytest.mark.slow
+def test_the_same_study_gives_the_same_files_byte_for_byte(study):
+    _, first, second, _ = study
+    for name in ("results.json", "results.csv", "candidates/std.yaml", "candidates/fwd.yaml"):
+        assert (first / name).read_bytes() == (second / name).read_bytes(), name
+
+
+@pytest.mark.slow
+def test_resume_keeps_what_is_done_and_runs_the_rest(study, tmp_path):
+    _, first, _, _ = study
+    out = tmp_path / "resumed"
+    shutil.copytree(first, out)
+    results = json.loads((out / "results.json").read_text())
+    del results["candidates"]["fwd"]["scenarios"]["turning"]
+    (out / "results.json").write_text(json.dumps(results, indent=2) + "\n")
+    study_file = tmp_path / "study.yaml"
+    study_file.write_text(STUDY)
+    done = design_study(str(study_file), "--out", str(out), "--resume", "--jobs", "1")
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "1 runs" in done.stderr or "7 already in" in done.stderr
+    assert (out / "results.json").read_bytes() == (first / "results.json").read_bytes()
+
+
+@pytest.mark.slow  # a process
+def test_a_broken_study_is_refused_before_anything_runs(tmp_path):
+    path = tmp_path / "study.yaml"
+    path.write_text("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {turnng: {}}\n")
+    done = design_study(str(path), "--out", str(tmp_path / "out"), timeout=120)
+    assert done.returncode == 2
+    assert "scenarios.turnng: {}: unknown key (did you mean 'turning'?)" in done.stderr
+    assert "Traceback" not in done.stderr and not os.path.exists(tmp_path / "out")
+
+
+@pytest.mark.slow  # a process
+def test_a_candidate_that_cannot_be_built_fails_alone(tmp_path):
+    """A candidate whose as-built file is missing is reported failed with its reason; the other runs."""
+    path = tmp_path / "study.yaml"
+    path.write_text(
+        "candidates: {good: {robot: thorvald_ii_4wd4ws_std},"
+        " bad: {robot: thorvald_ii_4wd4ws_std, as_built: no_such_as_built.yaml}}\n"
+        "scenarios: {turning: {settle: 1}}\n"
+    )
+    done = design_study(str(path), "--out", str(tmp_path / "out"), "--jobs", "2", timeout=300)
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert results["candidates"]["good"]["status"] == "ok", done.stderr[-2000:]
+    status = results["candidates"]["bad"]["status"]
+    assert status.startswith("failed: cannot be built: ") and "no_such_as_built.yaml" in status, status
+    assert done.returncode == 0  # one candidate ran: the study did what it could
