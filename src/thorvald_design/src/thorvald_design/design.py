@@ -16,6 +16,10 @@ from thorvald_sim.world.values import SURFACE_KINDS
 
 from .quasi_static import Layout, gradeability, layout_of, max_pull, overturning_angles
 
+PIPE_RADIUS = 0.025  # [m] of the frame's tubes
+BATTERY_HALF_HEIGHT = 0.2  # [m] of a battery enclosure, below its z
+DEFAULT_CLEARANCE = 0.5  # [m] of a robot file with no frame members
+
 
 @dataclass(frozen=True)
 class Design:
@@ -30,6 +34,18 @@ class Design:
     rear: float  # [m] from the origin back to the rearmost wheel's back
     width: float  # [m] across the wheels' outer sides
     _limits: Dict = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def clearance(self) -> float:
+        """[m] from the ground to the underside of the frame's lowest member: its pipes, corners,
+        battery enclosures and frame parts (the drive modules' legs come down over their wheels and
+        are counted with them). What a plant taller than this brushes."""
+        c = self.config
+        lows = [p.height - p.space / 2.0 - PIPE_RADIUS for p in c.pipes]
+        lows += [k.z - k.space / 2.0 - PIPE_RADIUS for k in c.corners]
+        lows += [b.z - BATTERY_HALF_HEIGHT for b in c.batteries]
+        lows += [f.z - max(f.size_z, f.radius, f.length) / 2.0 for f in c.frame_parts]
+        return max(0.0, min(lows)) if lows else DEFAULT_CLEARANCE
 
     @property
     def length(self) -> float:

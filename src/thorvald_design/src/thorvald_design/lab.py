@@ -7,12 +7,14 @@ Not pure: it runs pybullet (one DIRECT client a session, closed at its end).
 """
 
 import math
+from dataclasses import dataclass
 from typing import Callable, List, Mapping, Optional, Sequence, Tuple
 
 import pybullet as p
 
 from thorvald_sim.robot import MotorLoad
 from thorvald_sim.runner import RobotSession, RunOptions
+from thorvald_sim.simulation import Camera, save_png
 from thorvald_sim.world import parse_world
 
 from .scenarios.kind import Pose, Twist
@@ -21,10 +23,15 @@ from .scenarios.kind import Pose, Twist
 class LabSession:
     """One drive: the candidate spawned in a world; base_link's pose recorded at every control instant."""
 
-    def __init__(self, robot_file: str, options: RunOptions, world: Mapping, name: str):
+    def __init__(self, robot_file: str, options: RunOptions, world: Mapping, name: str, label: str = ""):
         self._session = RobotSession(robot_file, options, parse_world(dict(world), source=name))
+        self.world = world
+        self.label = label  # what the drive is, for the report's maps ("climb 14 deg")
+        self.outcome = ""  # what came of it, set by the scenario ("ok", "traction", ...)
+        self.shown: Optional[Mapping] = None  # the world the report draws, if not the physics' (plants)
         self.track: List[Pose] = []
         self.outline = self._outline()
+        self.on_close: Optional[Callable[[LabSession], None]] = None
 
     @property
     def time(self) -> float:
@@ -76,7 +83,18 @@ class LabSession:
                 points.append((c * dx + s * dy, -s * dx + c * dy))
         return tuple(points)
 
+    def picture(self, path: str, width: int = 480, height: int = 360) -> None:
+        """A PNG of the robot where it stands, from its front left and above (pybullet's software renderer)."""
+        (x, y, z), _ = self._session.robot.world_pose()
+        reach = max(math.hypot(px, py) for px, py in self.outline) + 0.5
+        camera = Camera(eye=(x + 1.6 * reach, y + 1.2 * reach, z + 1.3 * reach), target=(x, y, z + 0.45),
+                        width=width, height=height, fov=45.0)  # fmt: skip
+        save_png(self._session.sim.render(camera), path)
+
     def close(self) -> None:
+        if self.on_close is not None:
+            self.on_close(self)
+            self.on_close = None
         self._session.close()
 
     def __enter__(self) -> "LabSession":
@@ -86,8 +104,19 @@ class LabSession:
         self.close()
 
 
+@dataclass(frozen=True)
+class Drive:
+    """One finished drive, for the report's maps: what it was, its world, how it ended, its track."""
+
+    label: str
+    outcome: str
+    world: Mapping
+    track: Tuple[Pose, ...]
+
+
 class Lab:
-    """Makes the sessions of one candidate's runs: its robot file, as-built and seed."""
+    """Makes the sessions of one candidate's runs: its robot file, as-built and seed; keeps each
+    finished drive (:attr:`drives`)."""
 
     def __init__(self, robot_file: str, as_built: str = "", seed: int = 0, physics_rate: float = 240.0):
         self.robot_file = robot_file
@@ -95,12 +124,27 @@ class Lab:
         self.seed = seed
         self.physics_rate = physics_rate
         self.sessions = 0  # made so far: each a spawn in a world of its own
+        self.drives: List[Drive] = []
 
     def session(
-        self, world: Mapping, *, x: float = 0.0, y: float = 0.0, z: float = 0.0, yaw: float = 0.0, roll: float = 0.0
+        self,
+        world: Mapping,
+        *,
+        x: float = 0.0,
+        y: float = 0.0,
+        z: float = 0.0,
+        yaw: float = 0.0,
+        roll: float = 0.0,
+        label: str = "",
     ) -> LabSession:
         self.sessions += 1
         options = RunOptions(
             as_built=self.as_built, seed=self.seed, x=x, y=y, z=z, yaw=yaw, roll=roll, physics_rate=self.physics_rate
         )
-        return LabSession(self.robot_file, options, world, name=f"<scenario world {self.sessions}>")
+        session = LabSession(self.robot_file, options, world, name=f"<scenario world {self.sessions}>", label=label)
+        session.on_close = self._keep
+        return session
+
+    def _keep(self, session: LabSession) -> None:
+        world = session.shown if session.shown is not None else session.world
+        self.drives.append(Drive(session.label, session.outcome, world, tuple(session.track)))

@@ -41,9 +41,13 @@ def results_table(results: Mapping[str, Any], study) -> str:
     return "\n".join("  ".join(cell.ljust(w) for cell, w in zip(line, widths)).rstrip() for line in lines)
 
 
+CELL = 40  # [characters] of a text cell on the terminal (results.json and the CSV keep it whole)
+
+
 def _text(value: Any) -> str:
     if value is None:
         return "-"
     if isinstance(value, float):
         return f"{value:.3g}" if abs(value) < 1000 else f"{value:.0f}"
-    return str(value)
+    text = " ".join(str(value).split())
+    return text if len(text) <= CELL else text[: CELL - 3] + "..."

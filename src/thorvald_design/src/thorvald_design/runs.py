@@ -10,6 +10,7 @@ Not pure: the runs run pybullet.
 """
 
 import json
+import math
 import os
 import traceback
 from dataclasses import dataclass
@@ -34,6 +35,7 @@ class Job:
     seed: int
     scenario: str
     params: Tuple[Tuple[str, Any], ...]
+    out_dir: str = ""  # where the run's tracks and the candidate's picture go ("": nowhere)
 
     @property
     def label(self) -> str:
@@ -61,9 +63,8 @@ def prepare(study: Study, out_dir: str) -> List[Job]:
             header += f", payload {candidate.payload.mass:g} kg"
         _write_if_changed(path, header + "\n" + text)
         for scenario, params in study.scenarios:
-            jobs.append(
-                Job(candidate.name, path, candidate.as_built, study.seed, scenario, tuple(sorted(params.items())))
-            )
+            params_ = tuple(sorted(params.items()))
+            jobs.append(Job(candidate.name, path, candidate.as_built, study.seed, scenario, params_, out_dir))
     return jobs
 
 
@@ -103,7 +104,46 @@ def run_one(job: Job) -> Dict[str, Any]:
         out.update(result=f"failed: broke: {_one_line(e)} ({os.path.basename(where.filename)}:{where.lineno})")
         return out
     out["result"] = result
+    if job.out_dir:
+        write_tracks(os.path.join(job.out_dir, "tracks", safe_name(job.candidate), job.scenario + ".json"), lab.drives)
+        picture = os.path.join(job.out_dir, "pictures", safe_name(job.candidate) + ".png")
+        if not os.path.exists(picture):
+            take_picture(Lab(job.robot_file, job.as_built, job.seed), picture)
     return out
+
+
+TRACK_PERIOD = 0.1  # [s] between the poses a track file keeps
+
+
+def write_tracks(path: str, drives) -> None:
+    """The drives' tracks (world frame, a pose every TRACK_PERIOD) and worlds, for the report's maps."""
+    tracks = []
+    for drive in drives:
+        kept, last = [], -math.inf
+        for q in drive.track:
+            if q.t - last >= TRACK_PERIOD - 1e-9:
+                kept.append(q)
+                last = q.t
+        tracks.append(
+            {
+                "label": drive.label,
+                "outcome": drive.outcome,
+                "world": drive.world,
+                **{k: [round(getattr(q, k), 4) for q in kept] for k in ("t", "x", "y", "yaw")},
+            }
+        )
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    _write_json(path, {"world": drives[-1].world if drives else {}, "tracks": tracks})
+
+
+def take_picture(lab, path: str) -> None:
+    """The candidate standing on tarmac, rendered to PNG (written whole, then moved into place: two
+    workers may take it at once)."""
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with lab.session({"ground": {"surface": "tarmac"}}, label="picture") as session:
+        session.run(0.5, lambda t: (0.0, 0.0, 0.0))
+        session.picture(path + f".{os.getpid()}.png")
+    os.replace(path + f".{os.getpid()}.png", path)
 
 
 def _one_line(e: BaseException) -> str:
@@ -161,8 +201,11 @@ def read_results(out_dir: str) -> Optional[Dict[str, Any]]:
 
 def write_results(out_dir: str, results: Mapping[str, Any]) -> None:
     """results.json, written whole to a new file then moved over the old (a reader never sees half)."""
-    path = os.path.join(out_dir, RESULTS)
+    _write_json(os.path.join(out_dir, RESULTS), results)
+
+
+def _write_json(path: str, value: Any) -> None:
     with open(path + ".part", "w", encoding="utf-8") as f:
-        json.dump(results, f, indent=2, sort_keys=False)
+        json.dump(value, f, indent=2, sort_keys=False)
         f.write("\n")
     os.replace(path + ".part", path)

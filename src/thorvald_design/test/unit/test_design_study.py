@@ -23,13 +23,19 @@ scenarios:
   gradeability: {surface: grass, start_deg: 6, step_deg: 4, max_deg: 34}
   side_slope: {surface: grass, start_deg: 10, step_deg: 10, max_deg: 30, distance: 3}
   turning: {settle: 2}
+  headland: {row_spacing: 0.75}
+  obstacle: {start_m: 0.06, step_m: 0.06, max_m: 0.18}
   drawbar: {surface: grass, step_n: 100, hold_s: 1.5}
+  energy: {rows: 3, row_length: 6, speed: 1.0}
 """
 KEYS = {
     "gradeability": {"surface", "max_climb_deg", "limited_by", "max_descent_deg"},
     "side_slope": {"max_traverse_deg", "static_overturning_deg", "drift_per_m"},
     "turning": {"turning_diameter_m", "clearance_diameter_m"},
     "drawbar": {"max_pull_n"},
+    "headland": {"min_headland_m", "turn", "plants_touched"},
+    "obstacle": {"max_step_m"},
+    "energy": {"wh_per_km", "wh_per_ha", "peak_current_a", "range_km"},
 }
 
 
@@ -75,7 +81,11 @@ def test_every_candidate_has_every_scenarios_metrics(study):
         float(rows[0]["gradeability.max_climb_deg"])
         == results["candidates"]["std"]["scenarios"]["gradeability"]["max_climb_deg"]
     )
-    assert "gradeability.max_climb_deg" in done.stdout and "[8/8]" in done.stderr  # the table, the progress
+    assert "gradeability.max_climb_deg" in done.stdout and "[14/14]" in done.stderr  # the table, the progress
+    for name in ("std", "fwd"):  # what the report draws: a picture of each, the tracks of each run
+        assert (first / "pictures" / f"{name}.png").stat().st_size > 10_000
+        tracks = json.loads((first / "tracks" / name / "gradeability.json").read_text())
+        assert [t["label"] for t in tracks["tracks"]][:2] == ["climb 6 deg", "climb 10 deg"]
 
 
 @pytest.mark.slow
@@ -129,6 +139,37 @@ def test_side_slopes_are_held_only_below_the_static_overturning_angle(study):
     # the tricycle's battery side is its weak side: 5.7 degrees, and its traverse with that side downhill tips
     assert fwd["static_overturning_deg"] == pytest.approx(5.72, abs=0.1)
     assert fwd["traverses"][0][2][0] == "tipping"
+
+
+@pytest.mark.slow
+def test_headland_turns_are_the_ones_each_robot_can_make(study):
+    """std (every wheel steers, it spins) makes U, crab and spin turns without touching a plant; fwd
+    (fixed rear wheels, 0.45 m from its turn's centre to base_link) cannot U-turn between 0.75 m rows and
+    makes an omega turn, its centred front wheel running along the row's plants."""
+    results = study[0]
+    std = results["candidates"]["std"]["scenarios"]["headland"]
+    fwd = results["candidates"]["fwd"]["scenarios"]["headland"]
+    assert {t for t, r in std["turns"].items() if isinstance(r, dict) and r["works"]} == {"U", "crab", "spin"}
+    assert std["plants_touched"] == 0 and std["turn"] in ("U", "crab")
+    assert fwd["turns"]["U"].startswith("n/a: its tightest turn") and fwd["turns"]["crab"].startswith("n/a")
+    assert fwd["turn"] == "omega" and fwd["plants_touched"] > 0
+    for turn in (std, fwd):  # the robot must leave the rows whole before it turns
+        assert turn["min_headland_m"] > 1.0
+
+
+@pytest.mark.slow
+def test_steps_and_energy(study):
+    results = study[0]
+    std, fwd = (results["candidates"][n]["scenarios"] for n in ("std", "fwd"))
+    assert 0.06 <= std["obstacle"]["max_step_m"] < 0.2  # below its wheels' axles
+    assert fwd["obstacle"]["max_step_m"] <= std["obstacle"]["max_step_m"]
+    energy = std["energy"]
+    assert energy["wh_per_km"] == pytest.approx(energy["energy_wh"] / (energy["distance_m"] / 1000.0), rel=1e-3)
+    assert 20.0 < energy["wh_per_km"] < 300.0 and 0.99 < energy["end_soc"] < 1.0
+    # its 4.8 kWh pack at this rate: range = capacity / (Wh per km), give or take the pack's internal loss
+    assert energy["range_km"] == pytest.approx(4800.0 / energy["wh_per_km"], rel=0.05)
+    # the tricycle tips over in the tight headland turn at 1 m/s (v^2 / R = 2 m/s^2 > g tan 5.7 deg)
+    assert fwd["energy"]["wh_per_km"].startswith("n/a: it tipped over")
 
 
 @pytest.mark.slow

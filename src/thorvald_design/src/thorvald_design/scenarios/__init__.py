@@ -8,12 +8,15 @@ A new scenario is its module (a :class:`~thorvald_design.scenarios.kind.Scenario
 from typing import Dict, Tuple
 
 from .drawbar import DRAWBAR
+from .energy import ENERGY
 from .gradeability import GRADEABILITY
+from .headland import HEADLAND
 from .kind import ScenarioKind, not_applicable
+from .obstacle import OBSTACLE
 from .side_slope import SIDE_SLOPE
 from .turning import TURNING
 
-BUILT_IN: Tuple[ScenarioKind, ...] = (GRADEABILITY, SIDE_SLOPE, TURNING, DRAWBAR)
+BUILT_IN: Tuple[ScenarioKind, ...] = (GRADEABILITY, SIDE_SLOPE, TURNING, HEADLAND, OBSTACLE, DRAWBAR, ENERGY)
 SCENARIOS: Dict[str, ScenarioKind] = {kind.name: kind for kind in BUILT_IN}
 
 __all__ = ["BUILT_IN", "SCENARIOS", "ScenarioKind", "not_applicable"]

@@ -43,7 +43,7 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
     predicted = design.pull_limit(surface, params["hitch_height"])
     held, limited_by = 0.0, f"none up to {MAX_STEPS * params['step_n']:g} N"
     loads: List[tuple] = []
-    with lab.session(flat_world(surface)) as session:
+    with lab.session(flat_world(surface), label="pull") as session:
         command = heading_hold(session, 0.0, speed)
         session.run(params["settle"], command)
         for k in range(1, MAX_STEPS + 1):
@@ -69,6 +69,7 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
                 limited_by = "motor torque" if share >= TORQUE_BOUND else "traction"
                 break
             held = pull
+        session.outcome = f"held {held:g} N"
     return {
         "max_pull_n": held,
         "limited_by": limited_by,

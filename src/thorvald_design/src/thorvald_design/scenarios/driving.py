@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass
 from typing import Dict, Optional, Sequence, Tuple
 
+from thorvald_model.layout import axle_lines
 from thorvald_sim.world.values import SURFACE_KINDS
 
 from .kind import Pose
@@ -92,14 +93,31 @@ def at_time(track: Sequence[Pose], t: float) -> Pose:
     return track[lo]
 
 
+def feasible_twist(config, vx: float, wz: float) -> Tuple[float, float, float]:
+    """The twist (vx, vy, wz) in base_link that drives base_link ahead at vx [m/s] turning at wz
+    [rad/s] and that the robot's wheels allow: a wheel that cannot steer cannot slide sideways, so
+    a point of its axle line must move along the wheel only. For the axle line through (lx, ly)
+    along (dx, dy) (:func:`thorvald_model.layout.axle_lines`) that point moves at
+    (vx - wz ly, vy + wz lx), whose component along the axle is 0:
+    (vx - wz ly) dx + (vy + wz lx) dy = 0, so vy = -((vx - wz ly) dx) / dy - wz lx. A robot whose
+    wheels all steer takes vy = 0; one whose axle line runs along x (dy = 0) cannot drive ahead and
+    turn both, and is given vy = 0 too (its calculator refuses what it cannot do)."""
+    lines = axle_lines(config.drives, config.passive_wheels)
+    if not lines or abs(lines[0].dy) < 1e-9:
+        return (vx, 0.0, wz)
+    line = lines[0]
+    return (vx, -((vx - wz * line.y) * line.dx) / line.dy - wz * line.x, wz)
+
+
 def heading_hold(session, heading: float, speed: float, gain: float = 1.5, max_rate: float = 0.5):
     """A command (of t, for the session's run) that drives at speed [m/s] holding heading [rad] (yaw):
-    the yaw error of the session's last pose fed back to the turn rate (a P controller, rate limited)."""
+    the yaw error of the session's last pose fed back to the turn rate (a P controller, rate limited),
+    as a twist the robot's wheels allow (:func:`feasible_twist`)."""
 
     def command(t: float) -> Tuple[float, float, float]:
         yaw = session.track[-1].yaw if session.track else heading
         error = math.atan2(math.sin(heading - yaw), math.cos(heading - yaw))
-        return (speed, 0.0, max(-max_rate, min(max_rate, gain * error)))
+        return feasible_twist(session.config, speed, max(-max_rate, min(max_rate, gain * error)))
 
     return command
 

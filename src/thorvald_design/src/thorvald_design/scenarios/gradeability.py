@@ -128,7 +128,7 @@ def _climb(lab, design, params, angle: float) -> str:
     limit = SETTLE + 2.0 * (goal - start_x) / speed + 10.0
     progress = Progress(slope=angle)
     loads: List[tuple] = []
-    with lab.session(world, x=start_x) as session:
+    with lab.session(world, x=start_x, label=f"climb {math.degrees(angle):g} deg") as session:
         session.run(SETTLE, lambda t: (0.0, 0.0, 0.0))
         command = heading_hold(session, 0.0, speed)
 
@@ -137,8 +137,12 @@ def _climb(lab, design, params, angle: float) -> str:
             return s.track[-1].x >= goal or progress.failed(s.track)
 
         session.run(limit, command, stop)
-        pose = session.track[-1]
-    if pose.x >= goal:
+        session.outcome = _climb_outcome(session.track[-1].x >= goal, progress, loads, design)
+    return session.outcome
+
+
+def _climb_outcome(reached: bool, progress: Progress, loads, design) -> str:
+    if reached:
         return "ok"
     if progress.outcome == "tipping":
         return "tipping"
@@ -159,7 +163,7 @@ def _descend(lab, design, params, angle: float) -> str:
     limit = SETTLE + 2.0 * (goal - start_x) / speed + 10.0
     tolerance = max(0.1, 0.3 * speed)
     outcome = []
-    with lab.session(world, x=start_x, z=height) as session:
+    with lab.session(world, x=start_x, z=height, label=f"descend {math.degrees(angle):g} deg") as session:
         session.run(SETTLE, lambda t: (0.0, 0.0, 0.0))
         command = heading_hold(session, 0.0, speed)
 
@@ -176,9 +180,8 @@ def _descend(lab, design, params, angle: float) -> str:
 
         session.run(limit, command, stop)
         reached = session.track[-1].x >= goal
-    if outcome:
-        return outcome[0]
-    return "ok" if reached else "stalled"
+        session.outcome = outcome[0] if outcome else "ok" if reached else "stalled"
+    return session.outcome
 
 
 GRADEABILITY = ScenarioKind(

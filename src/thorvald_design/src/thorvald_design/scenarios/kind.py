@@ -55,7 +55,15 @@ class Session(Protocol):
 
 class Lab(Protocol):
     def session(
-        self, world: Mapping, *, x: float = 0.0, y: float = 0.0, z: float = 0.0, yaw: float = 0.0, roll: float = 0.0
+        self,
+        world: Mapping,
+        *,
+        x: float = 0.0,
+        y: float = 0.0,
+        z: float = 0.0,
+        yaw: float = 0.0,
+        roll: float = 0.0,
+        label: str = "",
     ) -> Any:
         """A session (a context manager giving a :class:`Session`) of the candidate spawned at (x, y, z, yaw)
         in the world of the given world-file contents."""

@@ -117,7 +117,8 @@ def _traverse(lab, design, params, angle: float, way: float):
     heading = 0.0 if way > 0 else math.pi
     progress = Progress(ux=way, slope=angle)
     limit = SETTLE + 2.0 * distance / speed + 10.0
-    with lab.session(world, x=start_x, y=y, z=z, yaw=heading, roll=way * angle) as session:
+    label = f"{math.degrees(angle):g} deg, {'left' if way > 0 else 'right'} side uphill"
+    with lab.session(world, x=start_x, y=y, z=z, yaw=heading, roll=way * angle, label=label) as session:
         session.run(SETTLE, lambda t: (0.0, 0.0, 0.0))
         first = len(session.track)
         command = heading_hold(session, heading, speed)
@@ -126,7 +127,13 @@ def _traverse(lab, design, params, angle: float, way: float):
             return way * (s.track[-1].x - s.track[first].x) >= distance or progress.failed(s.track[first:])
 
         session.run(limit, command, stop)
-        poses = session.track[first:]
+        outcome, downhill = _traverse_outcome(session.track[first:], progress, way, heading, params)
+        session.outcome = outcome
+    return outcome, downhill
+
+
+def _traverse_outcome(poses, progress: Progress, way: float, heading: float, params):
+    distance = params["distance"]
     if progress.outcome:
         return progress.outcome, None
     if way * (poses[-1].x - poses[0].x) < distance:

@@ -103,12 +103,13 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
     for way in (1.0, -1.0):
         twist = turn_twist(centre, [(x, y) for _, x, y in contacts], params["speed"], way)
         period = 2.0 * math.pi / abs(twist[2])
-        with lab.session(flat_world(params["surface"]), x=0.0) as session:
+        with lab.session(flat_world(params["surface"]), label=f"turn {'left' if way > 0 else 'right'}") as session:
             session.run(params["settle"], lambda t, twist=twist: twist)
             start = len(session.track)
             session.run(params["settle"] + period, lambda t, twist=twist: twist)
             poses = session.track[start:]
             outline = session.outline
+            session.outcome = "ok"
         track = Track(
             t=np.array([q.t for q in poses]),
             x=np.array([q.x for q in poses]),
