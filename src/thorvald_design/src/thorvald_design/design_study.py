@@ -26,6 +26,7 @@ from thorvald_model.errors import ConfigError
 
 from .report_table import results_table, write_csv
 from .runs import Job, done, empty_results, merge, prepare, read_results, run_one, write_results
+from .search import run_search, search_table
 from .study import load_study
 
 
@@ -38,6 +39,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, metavar="DIR", help="where results.json, results.csv and the rest go")
     p.add_argument("--jobs", type=int, default=0, metavar="N", help="worker processes (default: the cores)")
     p.add_argument("--resume", action="store_true", help="keep the results already in DIR; run only the rest")
+    p.add_argument("--optimise", action="store_true", help="run the study's optimise: search instead of its candidates")
+    p.add_argument(
+        "--against-sweep",
+        action="store_true",
+        help="with --optimise: also run the full sweep of the same space and compare the fronts and runs",
+    )
     return p
 
 
@@ -51,6 +58,12 @@ def main(argv: Optional[List[str]] = None) -> int:
     except ConfigError as e:
         print(e, file=sys.stderr)
         return 2
+    if args.optimise:
+        if study.optimise is None:
+            print(f"{args.study}: --optimise needs an optimise: section (docs/design-studies.md)", file=sys.stderr)
+            return 2
+        print(search_table(run_search(study, args.out, against_sweep=args.against_sweep)))
+        return 0
     os.makedirs(args.out, exist_ok=True)
     jobs = prepare(study, args.out)
     results = empty_results(study)

@@ -52,20 +52,26 @@ def safe_name(name: str) -> str:
 
 def prepare(study: Study, out_dir: str) -> List[Job]:
     """Writes each candidate's robot file; the runs, candidate by candidate, scenario by scenario."""
-    os.makedirs(os.path.join(out_dir, "candidates"), exist_ok=True)
     jobs = []
     for candidate in study.candidates:
-        path = candidate_file(out_dir, candidate)
-        text = yaml.safe_dump(candidate.robot_data, sort_keys=False, default_flow_style=None)
-        header = f"# {candidate.name}: {candidate.robot_file}"
-        header += "".join(f", {k} = {v:g}" for k, v in candidate.swept)
-        if candidate.payload is not None:
-            header += f", payload {candidate.payload.mass:g} kg"
-        _write_if_changed(path, header + "\n" + text)
+        path = prepare_candidate(out_dir, candidate)
         for scenario, params in study.scenarios:
             params_ = tuple(sorted(params.items()))
             jobs.append(Job(candidate.name, path, candidate.as_built, study.seed, scenario, params_, out_dir))
     return jobs
+
+
+def prepare_candidate(out_dir: str, candidate: Candidate) -> str:
+    """Writes the candidate's robot file (as its runs load it) into DIR/candidates; its path."""
+    os.makedirs(os.path.join(out_dir, "candidates"), exist_ok=True)
+    path = candidate_file(out_dir, candidate)
+    text = yaml.safe_dump(dict(candidate.robot_data), sort_keys=False, default_flow_style=None)
+    header = f"# {candidate.name}: {candidate.robot_file}"
+    header += "".join(f", {k} = {v:g}" for k, v in candidate.swept)
+    if candidate.payload is not None:
+        header += f", payload {candidate.payload.mass:g} kg"
+    _write_if_changed(path, header + "\n" + text)
+    return path
 
 
 def _write_if_changed(path: str, text: str) -> None:
@@ -133,7 +139,7 @@ def write_tracks(path: str, drives) -> None:
             }
         )
     os.makedirs(os.path.dirname(path), exist_ok=True)
-    _write_json(path, {"world": drives[-1].world if drives else {}, "tracks": tracks})
+    write_json(path, {"world": drives[-1].world if drives else {}, "tracks": tracks})
 
 
 def take_picture(lab, path: str) -> None:
@@ -200,11 +206,12 @@ def read_results(out_dir: str) -> Optional[Dict[str, Any]]:
 
 
 def write_results(out_dir: str, results: Mapping[str, Any]) -> None:
-    """results.json, written whole to a new file then moved over the old (a reader never sees half)."""
-    _write_json(os.path.join(out_dir, RESULTS), results)
+    """results.json (:func:`write_json`)."""
+    write_json(os.path.join(out_dir, RESULTS), results)
 
 
-def _write_json(path: str, value: Any) -> None:
+def write_json(path: str, value: Any) -> None:
+    """JSON written whole to a new file, then moved over the old: a reader never sees half of it."""
     with open(path + ".part", "w", encoding="utf-8") as f:
         json.dump(value, f, indent=2, sort_keys=False)
         f.write("\n")

@@ -56,6 +56,7 @@ from thorvald_model.schema import (
     unknown_key_rule,
 )
 
+from .optimise import Range, parse_optimise, parse_range
 from .scenarios import SCENARIOS
 
 WHAT = "design study"
@@ -79,7 +80,7 @@ PAYLOAD_KEYS = (
     Key("y", float, 0.0),
     Key("z", float, 0.8),
 )
-KNOWN = ("description", "seed", "candidates", "scenarios")
+KNOWN = ("description", "seed", "candidates", "scenarios", "optimise")
 
 
 @dataclass(frozen=True)
@@ -104,6 +105,34 @@ class Candidate:
 
 
 @dataclass(frozen=True)
+class Space:
+    """A candidate whose sweep a search explores (``--optimise``): its robot file and what every
+    combination shares, and its key paths' values (a list of choices, or a Range)."""
+
+    name: str
+    robot_file: str
+    robot_data: Mapping
+    as_built: str
+    payload: Optional[Payload]
+    dimensions: Tuple[Tuple[str, Any], ...]  # (key path, tuple of values or optimise.Range)
+
+    def candidate(self, values: Mapping[str, float]) -> Candidate:
+        """The candidate of one combination (key path -> value), named as a sweep names it; ValueError
+        if the robot files' rules refuse it."""
+        swept = tuple((key_path, float(values[key_path])) for key_path, _ in self.dimensions)
+        problems: List[Problem] = []
+        robot = _applied(self.robot_data, swept, self.payload, self.name, problems)
+        label = self.name + "[" + ",".join(f"{k.split('.')[-1]}={v:g}" for k, v in swept) + "]"
+        if robot is None or problems:
+            raise ValueError(f"{label}: " + "; ".join(f"{p.path}: {p.rule}" for p in problems))
+        config = parse_robot_config(robot, f"{self.robot_file} ({label})")  # ConfigError: refused
+        refused = calculator_problems(config)
+        if refused:
+            raise ConfigError(f"{self.robot_file} ({label})", refused)
+        return Candidate(label, self.robot_file, robot, self.as_built, self.payload, swept, family=self.name)
+
+
+@dataclass(frozen=True)
 class Study:
     source: str
     description: str
@@ -111,6 +140,8 @@ class Study:
     candidates: Tuple[Candidate, ...]
     scenarios: Tuple[Tuple[str, Mapping[str, Any]], ...]  # (scenario, its checked parameters), in file order
     text: str = ""  # the study file as written (the report shows it)
+    optimise: Any = None  # thorvald_design.optimise.OptimiseSpec of an ``optimise:`` section, or None
+    space: Optional[Space] = None  # the optimised candidate's (among ``candidates`` too, unless it has a range)
 
 
 def load_study(path: str) -> Study:
@@ -127,10 +158,22 @@ def parse_study(data: Any, source: str = "<study>", base_dir: str = ".", text: s
     description = parse_scalar(data, TOP_KEYS[0], problems)
     seed = parse_scalar(data, TOP_KEYS[1], problems)
     scenarios = _scenarios(data.get("scenarios", MISSING), problems)
-    candidates = _candidates(data.get("candidates", MISSING), base_dir, problems)
+    raw_candidates = data.get("candidates", MISSING)
+    spec = parse_optimise(
+        data.get("optimise", MISSING),
+        "optimise",
+        problems,
+        candidates=raw_candidates if isinstance(raw_candidates, Mapping) else None,
+        scenarios=[name for name, _ in scenarios],
+    )
+    searched = spec.candidate if spec is not None else None
+    spaces: List[Space] = []
+    candidates = _candidates(raw_candidates, base_dir, problems, searched, spaces)
     if problems:
         raise ConfigError(source, problems, WHAT)
-    return Study(source, description, seed, tuple(candidates), tuple(scenarios), text)
+    return Study(
+        source, description, seed, tuple(candidates), tuple(scenarios), text, spec, spaces[0] if spaces else None
+    )
 
 
 # ---- scenarios ------------------------------------------------------------------------------------
@@ -157,7 +200,11 @@ def _scenarios(section: Any, problems: List[Problem]) -> List[Tuple[str, Mapping
 
 
 # ---- candidates -----------------------------------------------------------------------------------
-def _candidates(section: Any, base_dir: str, problems: List[Problem]) -> List[Candidate]:
+def _candidates(
+    section: Any, base_dir: str, problems: List[Problem], searched: Optional[str] = None, spaces: Optional[List] = None
+) -> List[Candidate]:
+    """The candidates, sweeps expanded; the one a search explores (``searched``) goes to ``spaces`` too
+    (and only there when a key path of its sweep is a range, which no sweep runs)."""
     if section is MISSING:
         problems.append(Problem("candidates", MISSING, "is required: a mapping of name -> {robot: ...}"))
         return []
@@ -170,14 +217,16 @@ def _candidates(section: Any, base_dir: str, problems: List[Problem]) -> List[Ca
         if not _NAME.match(str(name)):
             problems.append(Problem(path, MISSING, NAME_RULE))
             continue
-        out.extend(_candidate(str(name), entry, path, base_dir, problems))
+        out.extend(_candidate(str(name), entry, path, base_dir, problems, spaces=spaces if name == searched else None))
     if len(out) > MAX_CANDIDATES:
         rule = f"the sweeps make {len(out)} candidates: at most {MAX_CANDIDATES} (search with --optimise instead)"
         problems.append(Problem("candidates", MISSING, rule))
     return out
 
 
-def _candidate(name: str, entry: Any, path: str, base_dir: str, problems: List[Problem]) -> List[Candidate]:
+def _candidate(
+    name: str, entry: Any, path: str, base_dir: str, problems: List[Problem], *, spaces: Optional[List] = None
+) -> List[Candidate]:
     if not isinstance(entry, Mapping):
         problems.append(Problem(path, short(entry), "must be a mapping with robot: (and as_built, payload, sweep)"))
         return []
@@ -194,6 +243,15 @@ def _candidate(name: str, entry: Any, path: str, base_dir: str, problems: List[P
         data = read_yaml_file(robot_file, "robot configuration")
     except ConfigError as e:
         problems.append(Problem(f"{path}.robot", values["robot"], str(e)))
+        return []
+    ranges = [key_path for key_path, dimension in sweep if isinstance(dimension, Range)]
+    if spaces is not None:  # the search's space (--optimise); swept too when it has no range
+        spaces.append(Space(name, robot_file, data, values["as_built"], payload, tuple(sweep)))
+        if ranges:
+            return []
+    if ranges:
+        rule = "is a range {min, max}: only a search (optimise: candidate: " + name + ") runs one"
+        problems.append(Problem(f"{path}.sweep.{ranges[0]}", MISSING, rule))
         return []
     out = []
     combos = itertools.product(*(values_ for _, values_ in sweep)) if sweep else [()]
@@ -242,7 +300,7 @@ def _payload(raw: Any, path: str, problems: List[Problem]) -> Optional[Payload]:
     return Payload(values["mass"], values["x"], values["y"], values["z"])
 
 
-def _sweep(raw: Any, path: str, problems: List[Problem]) -> List[Tuple[str, Tuple[float, ...]]]:
+def _sweep(raw: Any, path: str, problems: List[Problem]) -> List[Tuple[str, Any]]:
     if raw is None:
         return []
     if not isinstance(raw, Mapping) or not raw:
@@ -256,8 +314,13 @@ def _sweep(raw: Any, path: str, problems: List[Problem]) -> List[Tuple[str, Tupl
             rule = "must be a robot file's key path SECTION.ENTRY.KEY (ENTRY may be *), e.g. motor_drives.*.y"
             problems.append(Problem(where, short(values), rule))
             continue
+        if isinstance(values, Mapping):  # {min, max}: a range a search explores
+            found = parse_range(values, where, problems)
+            if found is not None:
+                out.append((str(key_path), found))
+            continue
         if not isinstance(values, Sequence) or isinstance(values, str) or not values:
-            problems.append(Problem(where, short(values), "must be a list of numbers"))
+            problems.append(Problem(where, short(values), "must be a list of numbers (or {min, max} for a search)"))
             continue
         if len(values) > MAX_SWEEP_VALUES:
             problems.append(Problem(where, short(values), f"at most {MAX_SWEEP_VALUES} values"))
@@ -315,4 +378,4 @@ def _like(name: str, known: Mapping) -> str:
     return f" (did you mean {close!r}?)" if close else ""
 
 
-__all__ = ["Candidate", "Payload", "Study", "load_study", "parse_study"]
+__all__ = ["Candidate", "Payload", "Space", "Study", "load_study", "parse_study"]

@@ -220,3 +220,50 @@ def test_a_candidate_that_cannot_be_built_fails_alone(tmp_path):
     status = results["candidates"]["bad"]["status"]
     assert status.startswith("failed: cannot be built: ") and "no_such_as_built.yaml" in status, status
     assert done.returncode == 0  # one candidate ran: the study did what it could
+
+
+SEARCH = """\
+seed: 1
+candidates:
+  track:
+    robot: thorvald_ii_4wd4ws_std
+    sweep: {"motor_drives.*.y": [0.3, 0.45, 0.75]}
+scenarios:
+  headland: {row_spacing: 0.75, turns: crab}
+  turning: {settle: 1}
+optimise:
+  candidate: track
+  objectives: {turning.clearance_diameter_m: min, headland.plants_touched: min}
+  requirements: {headland.plants_touched: "<= 10"}
+  trials: 2
+"""
+
+
+@pytest.mark.slow  # a search and a sweep: 8 runs
+def test_a_search_finds_the_sweeps_front_with_fewer_runs(tmp_path):
+    """The track width for 0.75 m rows: at y = 0.75 the wheels ride the neighbouring rows (plants run over,
+    pruned by the requirement); of the others, the narrower turns in the smaller circle."""
+    path = tmp_path / "search.yaml"
+    path.write_text(SEARCH)
+    done = design_study(str(path), "--out", str(tmp_path / "out"), "--optimise", "--against-sweep")
+    assert done.returncode == 0, done.stderr[-3000:]
+    out = json.loads((tmp_path / "out" / "optimise.json").read_text())
+    assert out["scenario_order"] == ["headland", "turning"]  # the requirement's scenario first: pruning saves runs
+    search, comparison = out["search"], out["comparison"]
+    assert len(search["trials"]) == 2 and comparison["runs"]["sweep"] == 6
+    assert comparison["runs"]["search"] < comparison["runs"]["sweep"]
+    for trial in search["trials"]:
+        if trial["values"]["motor_drives.*.y"] == 0.75:
+            assert trial["state"] == "pruned" and "headland.plants_touched" in trial["reason"]
+    sweep_front = out["sweep"]["front"]
+    assert sweep_front == [{"motor_drives.*.y": 0.3}]  # the narrowest: the smallest circle, no plant touched
+    assert comparison["front"]["dominated"] == 0
+    assert "search: 2 combinations" in done.stdout
+
+
+@pytest.mark.slow  # a process
+def test_optimise_without_a_section_is_refused(tmp_path):
+    path = tmp_path / "study.yaml"
+    path.write_text("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {turning: {}}\n")
+    done = design_study(str(path), "--out", str(tmp_path / "out"), "--optimise", timeout=120)
+    assert done.returncode == 2 and "--optimise needs an optimise: section" in done.stderr
