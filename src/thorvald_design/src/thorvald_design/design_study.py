@@ -24,6 +24,7 @@ from tqdm import tqdm
 
 from thorvald_model.errors import ConfigError
 
+from .report import write_report
 from .report_table import results_table, write_csv
 from .runs import Job, done, empty_results, merge, prepare, read_results, run_one, write_results
 from .search import run_search, search_table
@@ -39,6 +40,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, metavar="DIR", help="where results.json, results.csv and the rest go")
     p.add_argument("--jobs", type=int, default=0, metavar="N", help="worker processes (default: the cores)")
     p.add_argument("--resume", action="store_true", help="keep the results already in DIR; run only the rest")
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on a Dask distributed scheduler (tcp://HOST:8786) instead of local worker processes",
+    )
     p.add_argument("--optimise", action="store_true", help="run the study's optimise: search instead of its candidates")
     p.add_argument(
         "--against-sweep",
@@ -77,19 +83,26 @@ def main(argv: Optional[List[str]] = None) -> int:
                                     "result": result}, study)  # fmt: skip
     todo = [job for job in jobs if not done(results, job)]
     write_results(args.out, results)
-    workers = args.jobs or os.cpu_count() or 1
     skipped = len(jobs) - len(todo)
+    try:
+        executor, workers, where = _executor(args, len(todo))
+    except (OSError, ValueError, TimeoutError) as e:
+        print(f"design_study: cannot reach the scheduler {args.scheduler}: {e}", file=sys.stderr)
+        return 2
     print(
         f"design_study: {len(study.candidates)} candidates x {len(study.scenarios)} scenarios = {len(jobs)} runs"
         + (f" ({skipped} already in {args.out})" if skipped else "")
-        + f", {min(workers, max(len(todo), 1))} worker processes",
+        + f", {where}",
         file=sys.stderr,
     )
     started = time.monotonic()
-    _run(todo, workers, results, study, args.out)
+    with executor:
+        _run(todo, executor, workers, results=results, study=study, out_dir=args.out)
     write_results(args.out, results)
     write_csv(os.path.join(args.out, "results.csv"), results, study)
     print(results_table(results, study))
+    page = write_report(args.out, results, study, pareto=study.pareto)
+    print(f"design_study: the report: {page}", file=sys.stderr)
     print(
         f"design_study: {len(todo)} runs in {time.monotonic() - started:.1f} s; results in {args.out}", file=sys.stderr
     )
@@ -97,33 +110,68 @@ def main(argv: Optional[List[str]] = None) -> int:
     return 1 if failed and len(failed) == len(results["candidates"]) else 0
 
 
-def _run(todo: List[Job], workers: int, results, study, out_dir: str) -> None:
+SCHEDULER_TIMEOUT = 10.0  # [s] to reach a Dask scheduler
+
+
+def _executor(args, runs: int):
+    """(a concurrent.futures executor, its workers, what it is): local worker processes (one pybullet
+    client each, started fresh: spawn), or a Dask distributed scheduler's workers (its
+    ``Client.get_executor()``), whose machines have the workspace installed and sourced."""
+    if args.scheduler:
+        from distributed import Client  # noqa: PLC0415 (only a study run on a cluster needs it)
+
+        client = Client(args.scheduler, timeout=SCHEDULER_TIMEOUT)
+        workers = max(1, sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values()))
+        return _DaskExecutor(client), workers, f"{workers} Dask workers at {args.scheduler}"
+    workers = min(args.jobs or os.cpu_count() or 1, max(runs, 1))
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
+    return pool, workers, f"{workers} worker processes"
+
+
+class _DaskExecutor:
+    """A Dask client's executor, closing the client with it."""
+
+    def __init__(self, client):
+        self.client = client
+        self.executor = client.get_executor(pure=False)
+
+    def submit(self, fn, *args):
+        return self.executor.submit(fn, *args)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.executor.shutdown(wait=True)
+        self.client.close()
+
+
+def _run(todo: List[Job], pool, workers: int, *, results, study, out_dir: str) -> None:
+    """Submits every run to the pool and gathers each result into results.json as it ends; the
+    progress bar names the runs that are running (a line a run without a terminal)."""
     if not todo:
         return
     bar = tqdm(total=len(todo), unit="run", file=sys.stderr, dynamic_ncols=True, disable=None)
     try:
-        with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=get_context("spawn")) as pool:
-            pending = {pool.submit(run_one, job): job for job in todo}
-            finished_runs = 0
-            running = list(todo[: min(workers, len(todo))])
-            bar.set_postfix_str(", ".join(j.label for j in running))
-            while pending:
-                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-                for future in finished:
-                    job = pending.pop(future)
-                    run = future.result()
-                    merge(results, run, study)
-                    write_results(out_dir, results)
-                    bar.update(1)
-                    finished_runs += 1
-                    if bar.disable:  # no terminal: a line a run
-                        print(
-                            f"[{finished_runs}/{len(todo)}] {job.label}: {_outcome(run)}", file=sys.stderr, flush=True
-                        )
-                    running = [j for j in running if j != job]
-                    waiting = [j for j in pending.values() if j not in running]
-                    running += waiting[: max(0, min(workers, len(pending)) - len(running))]
-                    bar.set_postfix_str(", ".join(j.label for j in running))
+        pending = {pool.submit(run_one, job): job for job in todo}
+        finished_runs = 0  # (a disabled bar counts nothing)
+        running = list(todo[: min(workers, len(todo))])
+        bar.set_postfix_str(", ".join(j.label for j in running))
+        while pending:
+            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for future in finished:
+                job = pending.pop(future)
+                run = future.result()
+                merge(results, run, study)
+                write_results(out_dir, results)
+                bar.update(1)
+                finished_runs += 1
+                if bar.disable:  # no terminal: a line a run
+                    print(f"[{finished_runs}/{len(todo)}] {job.label}: {_outcome(run)}", file=sys.stderr, flush=True)
+                running = [j for j in running if j != job]
+                waiting = [j for j in pending.values() if j not in running]
+                running += waiting[: max(0, min(workers, len(pending)) - len(running))]
+                bar.set_postfix_str(", ".join(j.label for j in running))
     finally:
         bar.close()
 

@@ -80,7 +80,7 @@ PAYLOAD_KEYS = (
     Key("y", float, 0.0),
     Key("z", float, 0.8),
 )
-KNOWN = ("description", "seed", "candidates", "scenarios", "optimise")
+KNOWN = ("description", "seed", "candidates", "scenarios", "optimise", "pareto")
 
 
 @dataclass(frozen=True)
@@ -141,6 +141,7 @@ class Study:
     scenarios: Tuple[Tuple[str, Mapping[str, Any]], ...]  # (scenario, its checked parameters), in file order
     text: str = ""  # the study file as written (the report shows it)
     optimise: Any = None  # thorvald_design.optimise.OptimiseSpec of an ``optimise:`` section, or None
+    pareto: Optional[Tuple[str, str]] = None  # two SCENARIO.METRIC columns the report's Pareto plot compares
     space: Optional[Space] = None  # the optimised candidate's (among ``candidates`` too, unless it has a range)
 
 
@@ -166,14 +167,34 @@ def parse_study(data: Any, source: str = "<study>", base_dir: str = ".", text: s
         candidates=raw_candidates if isinstance(raw_candidates, Mapping) else None,
         scenarios=[name for name, _ in scenarios],
     )
+    pareto = _pareto(data.get("pareto", MISSING), [name for name, _ in scenarios], problems)
     searched = spec.candidate if spec is not None else None
     spaces: List[Space] = []
     candidates = _candidates(raw_candidates, base_dir, problems, searched, spaces)
     if problems:
         raise ConfigError(source, problems, WHAT)
+    space = spaces[0] if spaces else None
     return Study(
-        source, description, seed, tuple(candidates), tuple(scenarios), text, spec, spaces[0] if spaces else None
+        source, description, seed, tuple(candidates), tuple(scenarios), text, optimise=spec, space=space, pareto=pareto
     )
+
+
+def _pareto(raw: Any, scenarios: List[str], problems: List[Problem]) -> Optional[Tuple[str, str]]:
+    """``pareto: [SCENARIO.METRIC, SCENARIO.METRIC]``: the two metrics the report's Pareto plot compares."""
+    if raw is MISSING or raw is None:
+        return None
+    rule = "must be a list of two metrics SCENARIO.METRIC of the study's scenarios, e.g. [gradeability.max_climb_deg, turning.turning_diameter_m]"  # noqa: E501
+    if not isinstance(raw, Sequence) or isinstance(raw, str) or len(raw) != 2:
+        problems.append(Problem("pareto", short(raw), rule))
+        return None
+    known = [f"{s}.{m}" for s in scenarios for m in SCENARIOS[s].results]
+    found = len(problems)
+    for k, column in enumerate(raw):
+        if column not in known:
+            close = close_key(str(column), known)
+            hint = f" (did you mean {close!r}?)" if close else f" (the study's: {', '.join(known)})"
+            problems.append(Problem(f"pareto[{k}]", column, "is not a metric of the study's scenarios" + hint))
+    return (str(raw[0]), str(raw[1])) if len(problems) == found else None
 
 
 # ---- scenarios ------------------------------------------------------------------------------------

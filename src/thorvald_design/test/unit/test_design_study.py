@@ -16,6 +16,7 @@ from thorvald_model.description import package_file
 STUDY = """\
 description: "two robots, every scenario, short"
 seed: 3
+pareto: [gradeability.max_climb_deg, turning.turning_diameter_m]
 candidates:
   std: {robot: thorvald_ii_4wd4ws_std}
   fwd: {robot: thorvald_ii_1wd1ws_fwd}
@@ -82,6 +83,7 @@ def test_every_candidate_has_every_scenarios_metrics(study):
         == results["candidates"]["std"]["scenarios"]["gradeability"]["max_climb_deg"]
     )
     assert "gradeability.max_climb_deg" in done.stdout and "[14/14]" in done.stderr  # the table, the progress
+    assert (first / "report.html").stat().st_size > 100_000 and (first / "plots" / "pareto.png").is_file()
     for name in ("std", "fwd"):  # what the report draws: a picture of each, the tracks of each run
         assert (first / "pictures" / f"{name}.png").stat().st_size > 10_000
         tracks = json.loads((first / "tracks" / name / "gradeability.json").read_text())
@@ -175,7 +177,7 @@ def test_steps_and_energy(study):
 @pytest.mark.slow
 def test_the_same_study_gives_the_same_files_byte_for_byte(study):
     _, first, second, _ = study
-    for name in ("results.json", "results.csv", "candidates/std.yaml", "candidates/fwd.yaml"):
+    for name in ("results.json", "results.csv", "candidates/std.yaml", "candidates/fwd.yaml", "report.html"):
         assert (first / name).read_bytes() == (second / name).read_bytes(), name
 
 
@@ -267,3 +269,41 @@ def test_optimise_without_a_section_is_refused(tmp_path):
     path.write_text("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {turning: {}}\n")
     done = design_study(str(path), "--out", str(tmp_path / "out"), "--optimise", timeout=120)
     assert done.returncode == 2 and "--optimise needs an optimise: section" in done.stderr
+
+
+SMALL = """\
+candidates:
+  std: {robot: thorvald_ii_4wd4ws_std}
+  fwd: {robot: thorvald_ii_1wd1ws_fwd}
+scenarios:
+  turning: {settle: 1}
+  drawbar: {surface: grass, step_n: 100, hold_s: 1.0}
+"""
+
+
+@pytest.mark.slow  # a Dask cluster of two worker processes on this machine's loopback, and the same runs locally
+def test_a_study_runs_on_a_dask_cluster_to_the_same_results(tmp_path):
+    """The same study on a local Dask cluster of two workers (--scheduler) and on local worker
+    processes gives the same results.json."""
+    from distributed import LocalCluster  # noqa: PLC0415
+
+    path = tmp_path / "study.yaml"
+    path.write_text(SMALL)
+    local = design_study(str(path), "--out", str(tmp_path / "local"), "--jobs", "2")
+    assert local.returncode == 0, local.stderr[-3000:]
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+    ) as cluster:
+        done = design_study(str(path), "--out", str(tmp_path / "dask"), "--scheduler", cluster.scheduler_address)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "2 Dask workers at tcp://127.0.0.1:" in done.stderr
+    assert (tmp_path / "dask" / "results.json").read_bytes() == (tmp_path / "local" / "results.json").read_bytes()
+
+
+@pytest.mark.slow  # a process
+def test_an_unreachable_scheduler_is_one_clean_error(tmp_path):
+    path = tmp_path / "study.yaml"
+    path.write_text("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {turning: {}}\n")
+    done = design_study(str(path), "--out", str(tmp_path / "out"), "--scheduler", "tcp://127.0.0.1:9", timeout=120)
+    assert done.returncode == 2 and "cannot reach the scheduler tcp://127.0.0.1:9" in done.stderr
+    assert "Traceback" not in done.stderr

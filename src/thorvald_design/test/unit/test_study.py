@@ -116,6 +116,12 @@ def test_a_robot_file_is_found_from_the_study_files_folder(tmp_path):
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {turning: {}}\nsede: 3",
          "sede: 3: unknown key (did you mean 'seed'?)"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}", "scenarios: <missing>: is required"),
+        ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {turning: {}}\n"
+         "pareto: [turning.turning_diameter, turning.clearance_diameter_m]",
+         "pareto[0]: 'turning.turning_diameter': is not a metric of the study's scenarios (did you mean "
+         "'turning.turning_diameter_m'?)"),
+        ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {turning: {}}\npareto: turning",
+         "pareto: 'turning': must be a list of two metrics"),
     ],
 )  # fmt: skip
 def test_a_broken_study_names_the_key_path_the_value_and_the_rule(text, expected):
