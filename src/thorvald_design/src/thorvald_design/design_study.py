@@ -26,7 +26,7 @@ from thorvald_model.errors import ConfigError
 
 from .report import write_report
 from .report_table import results_table, write_csv
-from .runs import Job, done, empty_results, merge, prepare, read_results, run_one, write_results
+from .runs import Job, done, empty_results, merge, prepare, read_results, run_one, write_json, write_results
 from .search import run_search, search_table
 from .study import load_study
 
@@ -96,8 +96,15 @@ def main(argv: Optional[List[str]] = None) -> int:
         file=sys.stderr,
     )
     started = time.monotonic()
+    timing: List[dict] = []
     with executor:
-        _run(todo, executor, workers, results=results, study=study, out_dir=args.out)
+        _run(todo, executor, workers, results=results, study=study, out_dir=args.out, timing=timing)
+    wall = time.monotonic() - started
+    write_json(
+        os.path.join(args.out, TIMING),
+        {"workers": workers, "wall_s": round(wall, 3), "simulated_s": round(sum(r["simulated_s"] for r in timing), 3),
+         "runs": timing},
+    )  # fmt: skip
     write_results(args.out, results)
     write_csv(os.path.join(args.out, "results.csv"), results, study)
     print(results_table(results, study))
@@ -146,7 +153,10 @@ class _DaskExecutor:
         self.client.close()
 
 
-def _run(todo: List[Job], pool, workers: int, *, results, study, out_dir: str) -> None:
+TIMING = "timing.json"  # each run's simulated and wall seconds (apart from results.json, which repeats to the byte)
+
+
+def _run(todo: List[Job], pool, workers: int, *, results, study, out_dir: str, timing: List[dict]) -> None:
     """Submits every run to the pool and gathers each result into results.json as it ends; the
     progress bar names the runs that are running (a line a run without a terminal)."""
     if not todo:
@@ -162,6 +172,8 @@ def _run(todo: List[Job], pool, workers: int, *, results, study, out_dir: str) -
             for future in finished:
                 job = pending.pop(future)
                 run = future.result()
+                if "timing" in run:
+                    timing.append({"run": job.label, **run["timing"]})
                 merge(results, run, study)
                 write_results(out_dir, results)
                 bar.update(1)

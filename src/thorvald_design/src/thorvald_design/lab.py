@@ -125,6 +125,7 @@ class Lab:
         self.physics_rate = physics_rate
         self.sessions = 0  # made so far: each a spawn in a world of its own
         self.drives: List[Drive] = []
+        self.simulated = 0.0  # [s] of simulated time over every finished session
 
     def session(
         self,
@@ -146,5 +147,6 @@ class Lab:
         return session
 
     def _keep(self, session: LabSession) -> None:
+        self.simulated += session.time
         world = session.shown if session.shown is not None else session.world
         self.drives.append(Drive(session.label, session.outcome, world, tuple(session.track)))

@@ -12,6 +12,7 @@ Not pure: the runs run pybullet.
 import json
 import math
 import os
+import time
 import traceback
 from dataclasses import dataclass
 from typing import Any, Dict, List, Mapping, Optional, Tuple
@@ -91,6 +92,7 @@ def run_one(job: Job) -> Dict[str, Any]:
     from .design import design_of  # noqa: PLC0415 (the worker's imports: xacro, pybullet)
     from .lab import Lab  # noqa: PLC0415
 
+    started = time.monotonic()
     out: Dict[str, Any] = {"candidate": job.candidate, "scenario": job.scenario, "mass_kg": None}
     try:
         design = design_of(job.candidate, job.robot_file)
@@ -110,6 +112,7 @@ def run_one(job: Job) -> Dict[str, Any]:
         out.update(result=f"failed: broke: {_one_line(e)} ({os.path.basename(where.filename)}:{where.lineno})")
         return out
     out["result"] = result
+    out["timing"] = {"simulated_s": round(lab.simulated, 3), "wall_s": round(time.monotonic() - started, 3)}
     if job.out_dir:
         write_tracks(os.path.join(job.out_dir, "tracks", safe_name(job.candidate), job.scenario + ".json"), lab.drives)
         picture = os.path.join(job.out_dir, "pictures", safe_name(job.candidate) + ".png")
