@@ -17,6 +17,7 @@ from thorvald_base.errors import (
 )
 from thorvald_base.kinematics import PltfClc1WD, PltfClc2WDiff, PltfClcStd, Twist
 from thorvald_base.plugins import CalculatorLoader, load_calculator, parse_plugin_file
+from thorvald_testing.packages import plugin_package
 
 BUILT_IN = ["pltf_clc_1wd::PltfClc1WD", "pltf_clc_2wdiff::PltfClc2WDiff", "pltf_clc_std::PltfClcStd"]
 
@@ -69,42 +70,22 @@ def test_malformed_description_file(tmp_path):
 
 def make_second_package(tmp_path, monkeypatch, base="thorvald_base.kinematics.std:PltfClcStd"):
     """A catkin package 'my_calcs' exporting two calculators for thorvald_base from its package.xml."""
-    pkg = tmp_path / "ws" / "src" / "my_calcs"
-    pkg.mkdir(parents=True)
-    (pkg / "package.xml").write_text(
-        textwrap.dedent(
-            """\
-            <?xml version="1.0"?>
-            <package format="3">
-              <name>my_calcs</name>
-              <version>0.0.1</version>
-              <description>Calculators of another package.</description>
-              <maintainer email="a@example.org">A</maintainer>
-              <license>BSD</license>
-              <buildtool_depend>catkin</buildtool_depend>
-              <exec_depend>thorvald_base</exec_depend>
-              <export>
-                <thorvald_base plugin="${prefix}/my_plugins.xml"/>
-              </export>
-            </package>
-            """
-        )
-    )
-    (pkg / "my_plugins.xml").write_text(
-        textwrap.dedent(
-            """\
-            <class_libraries>
-              <library path="my_calcs">
-                <class name="my_calcs::Halved" type="my_calcs_module:Halved">
-                  <description>The standard calculator at half speed.</description>
-                </class>
-                <class name="my_calcs::NotACalculator" type="my_calcs_module:NotACalculator">
-                  <description>Exported by mistake.</description>
-                </class>
-              </library>
-            </class_libraries>
-            """
-        )
+    plugin_package(
+        tmp_path / "ws" / "src" / "my_calcs",
+        "my_calcs",
+        "my_plugins.xml",
+        """\
+        <class_libraries>
+          <library path="my_calcs">
+            <class name="my_calcs::Halved" type="my_calcs_module:Halved">
+              <description>The standard calculator at half speed.</description>
+            </class>
+            <class name="my_calcs::NotACalculator" type="my_calcs_module:NotACalculator">
+              <description>Exported by mistake.</description>
+            </class>
+          </library>
+        </class_libraries>
+        """,
     )
     lib = tmp_path / "pylib"
     lib.mkdir()

@@ -13,6 +13,8 @@ import sys
 
 import pytest
 
+from thorvald_testing.sources import imported_names
+
 PACKAGES = ["thorvald_base", "thorvald_bringup", "thorvald_design", "thorvald_model", "thorvald_sim", "thorvald_teleop"]
 # The modules whose job is ROS or physics, and why; everything else must be pure.
 NOT_PURE = {
@@ -107,28 +109,6 @@ def test_the_plugin_loader_searches_the_workspace():
     assert "pltf_clc_std::PltfClcStd" in CalculatorLoader().known_names()
 
 
-def _imports_anywhere(path, module):
-    """Every module an import statement of the file names, at any depth (inside functions too),
-    relative imports resolved against the module's package."""
-    import ast  # noqa: PLC0415
-
-    with open(path) as f:
-        tree = ast.parse(f.read(), path)
-    package = module if path.endswith("__init__.py") else module.rpartition(".")[0]
-    names = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            names += [a.name for a in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level:
-                parts = package.split(".")
-                anchor = ".".join(parts[: len(parts) - node.level + 1])
-                base = f"{anchor}.{base}" if base else anchor
-            names += [base] + [f"{base}.{a.name}" for a in node.names]
-    return names
-
-
 def test_no_pure_module_imports_the_ros_runtime_even_inside_a_function():
     """An import inside a function escapes the import-time check above: the source is read instead.
     Importing a module of NOT_PURE (e.g. conversions) counts as importing what it imports; the
@@ -148,7 +128,7 @@ def test_no_pure_module_imports_the_ros_runtime_even_inside_a_function():
             if module in NOT_PURE or not path or not path.endswith(".py"):
                 continue
             checked += 1
-            bad = sorted({n for n in _imports_anywhere(path, module) if n.split(".")[0] in FORBIDDEN or n in NOT_PURE})
+            bad = sorted({n for n in imported_names(path, module) if n.split(".")[0] in FORBIDDEN or n in NOT_PURE})
             if bad:
                 offenders[module] = bad
     assert checked > 40

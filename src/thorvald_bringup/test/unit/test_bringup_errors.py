@@ -1,7 +1,6 @@
 """thorvald_bringup's errors: one hierarchy in errors.py, the old name importable where it was, and
 odometry_report printing each of them as one line with exit status 2."""
 
-import ast
 import os
 
 import pytest
@@ -9,22 +8,9 @@ import pytest
 from thorvald_bringup import errors
 from thorvald_bringup.odometry_report import manoeuvre_start
 from thorvald_bringup.odometry_report_cli import main
+from thorvald_testing.sources import exception_classes
 
 SOURCES = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "src", "thorvald_bringup"))
-
-
-def exception_classes(path):
-    """Names of the classes a source file defines that derive from an exception class (a base named
-    Exception or ending in Error, or one of the file's own such classes)."""
-    with open(path) as f:
-        tree = ast.parse(f.read(), path)
-    found = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ClassDef):
-            bases = {b.attr if isinstance(b, ast.Attribute) else getattr(b, "id", "") for b in node.bases}
-            if any(b == "Exception" or b.endswith("Error") or b in found for b in bases):
-                found.add(node.name)
-    return found
 
 
 def test_every_exception_of_the_package_is_in_errors_py():

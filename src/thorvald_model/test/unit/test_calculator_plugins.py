@@ -2,7 +2,6 @@
 refuses every file base_driver refuses, a calculator that cannot be loaded is a problem of the file,
 and no module of this package imports the packages above it (thorvald_base among them)."""
 
-import ast
 import importlib
 import json
 import os
@@ -19,6 +18,8 @@ from thorvald_model import ConfigError, parse_robot_config
 from thorvald_model.check_config import main
 from thorvald_model.errors import PluginImportError, PluginNotFoundError, PluginTypeError
 from thorvald_model.plugins import CALCULATORS, PluginLoader, calculator_loader, calculator_problems
+from thorvald_testing.packages import plugin_package
+from thorvald_testing.sources import imported_names
 
 WORKSPACE_SRC = os.path.dirname(PKG)
 # The workspace's packages above thorvald_model: each depends on it, so none may be imported by it.
@@ -163,27 +164,11 @@ def test_the_errors_carry_the_rule_and_name_the_calculator():
 def test_an_exported_calculator_whose_module_is_missing_names_the_export(tmp_path):
     """A second package exports a calculator whose module is not there: the problem says which
     package exports it as what."""
-    pkg = tmp_path / "ws" / "my_calcs"
-    pkg.mkdir(parents=True)
-    (pkg / "package.xml").write_text(
-        textwrap.dedent(
-            """\
-            <?xml version="1.0"?>
-            <package format="3">
-              <name>my_calcs</name>
-              <version>0.0.1</version>
-              <description>Calculators of another package.</description>
-              <maintainer email="a@example.org">A</maintainer>
-              <license>BSD</license>
-              <buildtool_depend>catkin</buildtool_depend>
-              <exec_depend>thorvald_base</exec_depend>
-              <export><thorvald_base plugin="${prefix}/plugins.xml"/></export>
-            </package>
-            """
-        )
-    )
-    (pkg / "plugins.xml").write_text(
-        '<library><class name="my_calcs::Gone" type="my_calcs_gone_module:Gone"><description/></class></library>'
+    plugin_package(
+        tmp_path / "ws" / "my_calcs",
+        "my_calcs",
+        "plugins.xml",
+        '<library><class name="my_calcs::Gone" type="my_calcs_gone_module:Gone"><description/></class></library>',
     )
     loader = calculator_loader(rospkg.RosPack(ros_paths=[str(tmp_path / "ws"), WORKSPACE_SRC]))
     config = parse_robot_config({"base_calculator": "my_calcs::Gone", "motor_drives": four_drives()}, "robot.yaml")
@@ -249,31 +234,6 @@ def model_modules():
     return out
 
 
-def imported_names(path, module):
-    """Every module an import statement of the file names, at any depth (inside functions too),
-    relative imports resolved, and every literal handed to importlib.import_module or __import__."""
-    with open(path) as f:
-        tree = ast.parse(f.read(), path)
-    package = module if path.endswith("__init__.py") else module.rpartition(".")[0]
-    names = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            names += [a.name for a in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level:
-                parts = package.split(".")
-                anchor = ".".join(parts[: len(parts) - node.level + 1])
-                base = f"{anchor}.{base}" if base else anchor
-            names.append(base)
-        elif isinstance(node, ast.Call) and node.args and isinstance(node.args[0], ast.Constant):
-            func = node.func
-            called = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
-            if called in ("import_module", "__import__") and isinstance(node.args[0].value, str):
-                names.append(node.args[0].value)
-    return names
-
-
 def test_the_source_scan_sees_an_upward_import(tmp_path):
     source = tmp_path / "m.py"
     source.write_text(
@@ -283,7 +243,12 @@ def test_the_source_scan_sees_an_upward_import(tmp_path):
         "    return importlib.import_module('thorvald_sim.world')\n"
     )
     names = imported_names(str(source), "thorvald_model.m")
-    assert names == ["importlib", "thorvald_base.plugins", "thorvald_sim.world"]
+    assert names == [
+        "importlib",
+        "thorvald_base.plugins",
+        "thorvald_base.plugins.load_calculator",
+        "thorvald_sim.world",
+    ]
 
 
 def test_no_module_imports_a_package_above_it_in_its_source():

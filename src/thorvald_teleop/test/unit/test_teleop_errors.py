@@ -1,7 +1,6 @@
 """thorvald_teleop's errors: one hierarchy in errors.py, the old names importable where they were, and
 the nodes refusing a parameter they cannot use with one fatal line and a non-zero exit."""
 
-import ast
 import os
 import subprocess
 
@@ -11,22 +10,9 @@ from thorvald_teleop import errors
 from thorvald_teleop.keyboard import KeyboardTeleop
 from thorvald_teleop.teleop import TeleopConfig, parameter_number
 from thorvald_testing import poll, stop_group
+from thorvald_testing.sources import exception_classes
 
 SOURCES = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "src", "thorvald_teleop"))
-
-
-def exception_classes(path):
-    """Names of the classes a source file defines that derive from an exception class (a base named
-    Exception or ending in Error, or one of the file's own such classes)."""
-    with open(path) as f:
-        tree = ast.parse(f.read(), path)
-    found = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ClassDef):
-            bases = {b.attr if isinstance(b, ast.Attribute) else getattr(b, "id", "") for b in node.bases}
-            if any(b == "Exception" or b.endswith("Error") or b in found for b in bases):
-                found.add(node.name)
-    return found
 
 
 def test_every_exception_of_the_package_is_in_errors_py():
