@@ -6,11 +6,15 @@ Pure: numbers and world-file contents (mappings), no simulator.
 
 import math
 from dataclasses import dataclass
-from typing import Dict, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
+import numpy as np
+
+from thorvald_model.errors import Problem
 from thorvald_model.layout import axle_lines
 from thorvald_sim.world.values import SURFACE_KINDS
 
+from ..metrics import Track
 from .kind import Pose
 
 SURFACES = tuple(SURFACE_KINDS)
@@ -120,6 +124,39 @@ def heading_hold(session, heading: float, speed: float, gain: float = 1.5, max_r
         return feasible_twist(session.config, speed, max(-max_rate, min(max_rate, gain * error)))
 
     return command
+
+
+def series(start: float, step: float, stop: float) -> List[float]:
+    """start, start + step, ... up to stop (rounded to a millionth: 0.1 + 0.2 is 0.3): the trials of a
+    scenario that tries ever steeper slopes or higher steps."""
+    out, k = [], 0
+    while True:
+        value = round(start + k * step, 6)
+        if value > stop + 1e-9:
+            return out
+        out.append(value)
+        k += 1
+
+
+def check_series(start_key: str, stop_key: str):
+    """A scenario's check that its series' last value is not below its first."""
+
+    def check(values: Mapping[str, Any], path: str, problems: List[Problem]) -> None:
+        if values[stop_key] < values[start_key]:
+            rule = f"must be >= {start_key} ({values[start_key]:g})"
+            problems.append(Problem(f"{path}.{stop_key}", values[stop_key], rule))
+
+    return check
+
+
+def track_of(poses: Sequence[Pose]) -> Track:
+    """The metrics' track of a session's poses (plan view: t, x, y, yaw)."""
+    return Track(
+        t=np.array([q.t for q in poses]),
+        x=np.array([q.x for q in poses]),
+        y=np.array([q.y for q in poses]),
+        yaw=np.array([q.yaw for q in poses]),
+    )
 
 
 def mean(values: Sequence[float]) -> float:

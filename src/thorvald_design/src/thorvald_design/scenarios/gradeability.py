@@ -34,10 +34,20 @@ simulated climb, a dynamic drive at speed, reaches it to within a step.
 import math
 from typing import Any, Dict, List, Mapping
 
-from thorvald_model.errors import Problem
 from thorvald_model.schema import Key, one_of
 
-from .driving import SURFACE_RULE, SURFACES, TIPPED, Progress, at_time, heading_hold, mean, ramp_world
+from .driving import (
+    SURFACE_RULE,
+    SURFACES,
+    TIPPED,
+    Progress,
+    at_time,
+    check_series,
+    heading_hold,
+    mean,
+    ramp_world,
+    series,
+)
 from .kind import ScenarioKind
 
 TORQUE_BOUND = 0.95  # of the motors' torque limit, on average over the last second: the motors are the limit
@@ -64,22 +74,12 @@ RESULTS = (
 )
 
 
-def check(values: Mapping[str, Any], path: str, problems: List[Problem]) -> None:
-    if values["max_deg"] < values["start_deg"]:
-        problems.append(
-            Problem(f"{path}.max_deg", values["max_deg"], f"must be >= start_deg ({values['start_deg']:g})")
-        )
+check = check_series("start_deg", "max_deg")
 
 
 def angles(params: Mapping[str, Any]) -> List[float]:
     """The ramps' angles [deg] in the order they are tried."""
-    out, k = [], 0
-    while True:
-        a = round(params["start_deg"] + k * params["step_deg"], 6)
-        if a > params["max_deg"] + 1e-9:
-            return out
-        out.append(a)
-        k += 1
+    return series(params["start_deg"], params["step_deg"], params["max_deg"])
 
 
 def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:

@@ -38,9 +38,9 @@ from thorvald_model.schema import Key, one_of
 from thorvald_sim.world import parse_world
 from thorvald_sim.world.values import plant_positions
 
-from ..metrics import Track, plants_touched
+from ..metrics import plants_touched
 from ..route import PurePursuit, line, path_of, turn
-from .driving import SURFACE_RULE, SURFACES, TIPPED, feasible_twist, flat_world
+from .driving import SURFACE_RULE, SURFACES, TIPPED, feasible_twist, flat_world, track_of
 from .gradeability import SETTLE
 from .kind import ScenarioKind, not_applicable
 from .turning import turn_centre
@@ -224,12 +224,7 @@ def _tipped(session) -> bool:
 
 def _measure(poses, outline, design, h: Headland, name: str) -> Dict[str, Any]:
     params, target = h.params, h.target
-    track = Track(
-        t=np.array([q.t for q in poses]),
-        x=np.array([q.x for q in poses]),
-        y=np.array([q.y for q in poses]),
-        yaw=np.array([q.yaw for q in poses]),
-    )
+    track = track_of(poses)
     end = poses[-1]
     backwards = name == "crab"  # it comes back driving backwards, heading as it left
     heading_ok = abs(math.cos(end.yaw)) > 0.9 and (math.cos(end.yaw) > 0) == backwards

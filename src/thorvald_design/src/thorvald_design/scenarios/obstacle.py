@@ -22,10 +22,9 @@ motor torque, as in gradeability), and never one as high as an axle (h < r: a ve
 import math
 from typing import Any, Dict, List, Mapping
 
-from thorvald_model.errors import Problem
 from thorvald_model.schema import Key, one_of
 
-from .driving import SURFACE_RULE, SURFACES, Progress, heading_hold, surface_keys
+from .driving import SURFACE_RULE, SURFACES, Progress, check_series, heading_hold, series, surface_keys
 from .gradeability import SETTLE
 from .kind import ScenarioKind
 
@@ -40,19 +39,12 @@ KEYS = (
 RESULTS = ("max_step_m", "max_step_down_m")
 
 
-def check(values: Mapping[str, Any], path: str, problems: List[Problem]) -> None:
-    if values["max_m"] < values["start_m"]:
-        problems.append(Problem(f"{path}.max_m", values["max_m"], f"must be >= start_m ({values['start_m']:g})"))
+check = check_series("start_m", "max_m")
 
 
 def heights(params: Mapping[str, Any]) -> List[float]:
-    out, k = [], 0
-    while True:
-        h = round(params["start_m"] + k * params["step_m"], 6)
-        if h > params["max_m"] + 1e-9:
-            return out
-        out.append(h)
-        k += 1
+    """The steps' heights [m] in the order they are tried."""
+    return series(params["start_m"], params["step_m"], params["max_m"])
 
 
 def step_world(surface: str, height: float, edge: float, length: float, width: float = 8.0) -> Dict:

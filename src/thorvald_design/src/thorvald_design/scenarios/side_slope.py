@@ -24,15 +24,12 @@ two sides. No robot should be driven near it: slip comes first on any real surfa
 """
 
 import math
-from typing import Any, Dict, List, Mapping
+from typing import Any, Dict, Mapping
 
-import numpy as np
-
-from thorvald_model.errors import Problem
 from thorvald_model.schema import Key, one_of
 
-from ..metrics import Track, lateral_drift
-from .driving import SURFACE_RULE, SURFACES, Progress, heading_hold, surface_keys
+from ..metrics import lateral_drift
+from .driving import SURFACE_RULE, SURFACES, Progress, check_series, heading_hold, surface_keys, track_of
 from .gradeability import SETTLE, angles
 from .kind import ScenarioKind
 
@@ -48,11 +45,7 @@ KEYS = (
 RESULTS = ("max_traverse_deg", "static_overturning_deg", "drift_per_m")
 
 
-def check(values: Mapping[str, Any], path: str, problems: List[Problem]) -> None:
-    if values["max_deg"] < values["start_deg"]:
-        problems.append(
-            Problem(f"{path}.max_deg", values["max_deg"], f"must be >= start_deg ({values['start_deg']:g})")
-        )
+check = check_series("start_deg", "max_deg")
 
 
 def side_slope_world(surface: str, angle: float, run: float, length: float) -> Dict:
@@ -138,12 +131,7 @@ def _traverse_outcome(poses, progress: Progress, way: float, heading: float, par
         return progress.outcome, None
     if way * (poses[-1].x - poses[0].x) < distance:
         return "ran out of time", None
-    track = Track(
-        t=np.array([q.t for q in poses]),
-        x=np.array([q.x for q in poses]),
-        y=np.array([q.y for q in poses]),
-        yaw=np.array([q.yaw for q in poses]),
-    )
+    track = track_of(poses)
     # the face rises to +y: downhill is to the right of heading +x, to the left of heading -x
     downhill = -way * lateral_drift(track, heading).per_m
     if downhill > params["max_drift"]:

@@ -31,13 +31,11 @@ a point on the axle line).
 import math
 from typing import Any, Dict, List, Mapping, Sequence, Tuple
 
-import numpy as np
-
 from thorvald_model.layout import axle_lines
 from thorvald_model.schema import Key, one_of
 
-from ..metrics import Track, turning_diameters
-from .driving import SURFACE_RULE, SURFACES, flat_world
+from ..metrics import turning_diameters
+from .driving import SURFACE_RULE, SURFACES, flat_world, track_of
 from .kind import ScenarioKind
 
 CENTRE_STEP = 0.005  # [m] the centre moves out in these steps until every steered wheel can stand
@@ -110,12 +108,7 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
             poses = session.track[start:]
             outline = session.outline
             session.outcome = "ok"
-        track = Track(
-            t=np.array([q.t for q in poses]),
-            x=np.array([q.x for q in poses]),
-            y=np.array([q.y for q in poses]),
-            yaw=np.array([q.yaw for q in poses]),
-        )
+        track = track_of(poses)
         found = turning_diameters(track, contacts, outline)
         ways.append(
             {
