@@ -13,7 +13,7 @@ from typing import Callable, List, Mapping, Optional, Sequence, Tuple
 import pybullet as p
 
 from thorvald_sim.robot import MotorLoad
-from thorvald_sim.runner import RobotSession, RunOptions
+from thorvald_sim.runner import RobotSession, RunOptions, Sample
 from thorvald_sim.simulation import Camera, save_png
 from thorvald_sim.world import parse_world
 
@@ -67,6 +67,18 @@ class LabSession:
 
     def push(self, force: Optional[Sequence[float]], at: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
         self._session.push(force, at)
+
+    def set_drive_params(self, changes: Sequence[Tuple[int, str, float]]) -> List[str]:
+        """Changes the candidate's drive parameters while it runs, as base_driver's ``set_drive_params``
+        does on a robot (:meth:`thorvald_base.core.BaseDriverCore.set_drive_params`): each change
+        (drive index, key, value) validated as the robot file is, used from the next control cycle on.
+        Returns the problems of the changes refused (the others are applied)."""
+        return self._session.core.set_drive_params(changes)[1]
+
+    @property
+    def odometry(self) -> List[Sample]:
+        """base_driver's odometry (in the odom frame: the spawn pose) at every control instant so far."""
+        return self._session.odometry
 
     def _outline(self) -> Tuple[Tuple[float, float], ...]:
         """The corners in plan of every link's bounding box at the spawn pose, in base_link [m]: the

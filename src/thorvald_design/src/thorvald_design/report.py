@@ -71,6 +71,7 @@ DIRECTIONS: Dict[str, int] = {
     "peak_current_a": -1,
     "rms_current_a": -1,
     "odometry_error_pct": -1,
+    "odometry_error_pct_without_switch": -1,
 }
 # The metrics that are words, not numbers: shown in the table, not plotted
 TEXT_METRICS = ("surface", "limited_by", "predicted_limited_by", "turn")

@@ -274,6 +274,11 @@ def _candidate(
         rule = "is a range {min, max}: only a search (optimise: candidate: " + name + ") runs one"
         problems.append(Problem(f"{path}.sweep.{ranges[0]}", MISSING, rule))
         return []
+    count = math.prod(len(values_) for _, values_ in sweep) if sweep else 1
+    if count > MAX_CANDIDATES:  # refused before any is made: each is a robot file checked
+        rule = f"the sweep makes {count} candidates: at most {MAX_CANDIDATES} (search with --optimise instead)"
+        problems.append(Problem(f"{path}.sweep", MISSING, rule))
+        return []
     out = []
     combos = itertools.product(*(values_ for _, values_ in sweep)) if sweep else [()]
     for combo in combos:

@@ -27,6 +27,7 @@ scenarios:
   headland: {row_spacing: 0.75}
   obstacle: {start_m: 0.06, step_m: 0.06, max_m: 0.18}
   drawbar: {surface: grass, step_n: 100, hold_s: 1.5}
+  rails: {rail_length: 2}
   energy: {rows: 3, row_length: 6, speed: 1.0}
 """
 KEYS = {
@@ -37,6 +38,7 @@ KEYS = {
     "headland": {"min_headland_m", "turn", "plants_touched"},
     "obstacle": {"max_step_m"},
     "energy": {"wh_per_km", "wh_per_ha", "peak_current_a", "range_km"},
+    "rails": {"odometry_error_pct", "odometry_error_pct_without_switch"},
 }
 
 
@@ -82,7 +84,7 @@ def test_every_candidate_has_every_scenarios_metrics(study):
         float(rows[0]["gradeability.max_climb_deg"])
         == results["candidates"]["std"]["scenarios"]["gradeability"]["max_climb_deg"]
     )
-    assert "gradeability.max_climb_deg" in done.stdout and "[14/14]" in done.stderr  # the table, the progress
+    assert "gradeability.max_climb_deg" in done.stdout and "[16/16]" in done.stderr  # the table, the progress
     assert (first / "report.html").stat().st_size > 100_000 and (first / "plots" / "pareto.png").is_file()
     for name in ("std", "fwd"):  # what the report draws: a picture of each, the tracks of each run
         assert (first / "pictures" / f"{name}.png").stat().st_size > 10_000
@@ -170,6 +172,8 @@ def test_steps_and_energy(study):
     assert 20.0 < energy["wh_per_km"] < 300.0 and 0.99 < energy["end_soc"] < 1.0
     # its 4.8 kWh pack at this rate: range = capacity / (Wh per km), give or take the pack's internal loss
     assert energy["range_km"] == pytest.approx(4800.0 / energy["wh_per_km"], rel=0.05)
+    # neither has rail wheels: the greenhouse robot's scenario says so (its own test drives it: test_rails.py)
+    assert std["rails"]["odometry_error_pct"] == "n/a: its drives have no rail wheels"
     # the tricycle tips over in the tight headland turn at 1 m/s (v^2 / R = 2 m/s^2 > g tan 5.7 deg)
     assert fwd["energy"]["wh_per_km"].startswith("n/a: it tipped over")
 

@@ -153,4 +153,4 @@ def test_a_sweep_too_large_for_a_machine_is_refused():
         f" 'motor_drives.*.r_wheel': {[round(0.15 + 0.001 * k, 3) for k in range(16)]}}}}}}}\n"
         "scenarios: {turning: {}}"
     )
-    assert f"the sweeps make 272 candidates: at most {MAX_CANDIDATES}" in text
+    assert f"candidates.a.sweep: <missing>: the sweep makes 272 candidates: at most {MAX_CANDIDATES}" in text

@@ -11,7 +11,7 @@ from typing import Callable, List, Mapping
 
 from .errors import MISSING, Problem
 from .layout import shared_layout_problems
-from .values import ALL_DIMENSIONS, FRAME_PART_DIMENSIONS, Drive, PassiveWheel, RobotConfig
+from .values import ALL_DIMENSIONS, FRAME_PART_DIMENSIONS, RAIL_FLANGE_DEPTH, Drive, PassiveWheel, RobotConfig
 
 SAME_SPOT_DISTANCE = 0.01  # [m]: closer wheel contacts are a typing mistake, not a design
 
@@ -182,6 +182,50 @@ def steering_offsets(config: RobotConfig, data: Mapping) -> List[Problem]:
     ]
 
 
+def rail_wheels(config: RobotConfig, data: Mapping) -> List[Problem]:
+    """A rail wheel is the smaller wheel of its drive's double wheel, its flanges clear of the floor
+    while the tyre rolls on it, and it sits beside the tyre, not in it; a drive without one has no
+    rail_offset.
+
+    r_wheel is the radius base_driver calculates with: the tyre's in the file, the rail wheel's
+    while the robot rides its rails (set_drive_params sets it to rail_r_wheel then, and every change
+    is validated as a file is), so a drive whose r_wheel equals its rail_r_wheel is in that state,
+    not a drive whose tyre is too small.
+    """
+    problems = []
+    for d in config.drives:
+        path = f"motor_drives.{d.name}."
+        if not d.has_rail_wheel:
+            if d.rail_offset != 0:
+                problems.append(
+                    Problem(
+                        path + "rail_offset", d.rail_offset, "must be 0: this drive has no rail wheel (rail_r_wheel 0)"
+                    )
+                )
+            continue
+        if d.r_wheel != d.rail_r_wheel and d.rail_flange_radius >= d.r_wheel:
+            problems.append(
+                Problem(
+                    path + "rail_r_wheel",
+                    d.rail_r_wheel,
+                    f"must be < r_wheel - {RAIL_FLANGE_DEPTH:g} = {d.r_wheel - RAIL_FLANGE_DEPTH:g} m: the tyre is "
+                    f"the larger wheel, and the rail wheel's flanges ({RAIL_FLANGE_DEPTH:g} m deeper) clear the floor "
+                    "while it rolls on it (equal to r_wheel only while riding the rails, set at run time)",
+                )
+            )
+        if abs(d.rail_offset) < d.rail_clearance_offset:
+            problems.append(
+                Problem(
+                    path + "rail_offset",
+                    d.rail_offset,
+                    f"must be at least {d.rail_clearance_offset:g} m either way: the rail wheel and its flanges "
+                    f"beside the tyre (half its width, {d.w_wheel / 2.0:g} m, and the rail wheel's half span over "
+                    f"its flanges, {d.rail_half_span:g} m), not in it",
+                )
+            )
+    return problems
+
+
 def wheel_layout(config: RobotConfig, data: Mapping) -> List[Problem]:
     """The layout rules every calculator shares (:mod:`thorvald_model.layout`); the calculator's own
     are its to declare and check (thorvald_base's BaseCalculator.layout_rules)."""
@@ -198,6 +242,7 @@ RULES: List[Rule] = [
     pipe_ends_differ,
     frame_part_dimensions,
     steering_offsets,
+    rail_wheels,
     wheel_layout,
 ]
 
@@ -224,9 +269,13 @@ def _reach(wheel) -> float:
     """How far a wheel's footprint reaches from its x, y, seen from above, as it turns [m].
 
     A wheel of radius r and width w is a 2r x w rectangle from above; turning about its centre it
-    sweeps a circle of radius hypot(r, w/2); a caster's wheel centre trails caster_offset behind.
+    sweeps a circle of radius hypot(r, w/2); a caster's wheel centre trails caster_offset behind. A
+    rail wheel beside the tyre is a 2 r_f x (its span) rectangle reaching |rail_offset| + its half
+    span along the axle (r_f its flanges' radius): it sweeps hypot(r_f, that), if that is further.
     """
     reach = math.hypot(wheel.r_wheel, wheel.w_wheel / 2.0)
+    if isinstance(wheel, Drive) and wheel.has_rail_wheel:
+        reach = max(reach, math.hypot(wheel.rail_flange_radius, abs(wheel.rail_offset) + wheel.rail_half_span))
     if isinstance(wheel, PassiveWheel) and not wheel.fixed:
         reach += wheel.caster_offset
     return reach

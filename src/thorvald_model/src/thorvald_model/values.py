@@ -22,6 +22,12 @@ from .errors import Problem
 from .schema import NON_NEGATIVE, POSITIVE, in_range, key, non_negative, one_of
 
 MAX_STEERING_OFFSET = 0.2  # [rad]: a drive's steering_offset beyond it is a broken module, not a homing error
+# A rail wheel's flanges (paper 3.1: the greenhouse robot's double wheels): a disc either side of the
+# tread, this much larger in radius than the tread (how far they reach down beside a pipe) and this
+# thick. 20 mm reach down a 51 mm pipe's sides to 5.5 mm above its centre, where it is nearly its
+# full width (2 sqrt(25.5^2 - 5.5^2) = 49.8 mm): enough to hold the wheel on it.
+RAIL_FLANGE_DEPTH = 0.02  # [m]
+RAIL_FLANGE_WIDTH = 0.01  # [m]
 FRAME_PART_COLORS = ("grey", "dark_grey", "black", "white", "silver", "orange", "red", "green", "blue", "yellow")
 
 
@@ -66,6 +72,15 @@ class Drive:
     steering_offset: float = key(
         0.0, lambda v: abs(v) <= MAX_STEERING_OFFSET, f"must be within +-{MAX_STEERING_OFFSET} rad", runtime=True
     )
+    # Ours: a flanged rail wheel on the tyre's axle, for greenhouse heating pipes (paper 3.1, the robot
+    # of Figure 2a): its radius (0: none), its tread's width between the flanges (0.06 takes a 51 mm
+    # pipe with 4.5 mm to spare either side) and its centre's offset from the tyre's centre along the
+    # axle (+y of the wheel link, which is base_link's +y with the wheel straight). On the floor the
+    # tyre carries the drive, on the pipes the rail wheel does (rules.py: the tyre is the larger);
+    # base_driver's r_wheel is the radius in use, which set_drive_params switches between the two.
+    rail_r_wheel: float = key(0.0, **NON_NEGATIVE)  # [m]
+    rail_w_wheel: float = key(0.06, **POSITIVE)  # [m]
+    rail_offset: float = key(0.0)  # [m]
     # Ours: the motors' torque limits, for the simulator. About 500 W at 3000 rpm for propulsion
     # (1.6 N m x 42 = 67 N m at the wheel, 336 N at a 0.2 m rim); 1 N m x 42.9 = 43 N m for steering,
     # enough to turn a loaded wheel on the spot on tarmac.
@@ -121,6 +136,28 @@ class Drive:
     def max_wheel_speed(self) -> float:
         """Highest wheel rim speed the motor allows [m/s]."""
         return self.max_wheel_rate * self.r_wheel
+
+    @property
+    def has_rail_wheel(self) -> bool:
+        """A flanged rail wheel is fitted beside the tyre (``rail_r_wheel`` > 0)."""
+        return self.rail_r_wheel > 0
+
+    @property
+    def rail_flange_radius(self) -> float:
+        """Radius of the rail wheel's flanges [m] (0 without a rail wheel)."""
+        # rounded to the nanometre, so that the description reads 0.17 and not 0.16999999999999998
+        return round(self.rail_r_wheel + RAIL_FLANGE_DEPTH, 9) if self.has_rail_wheel else 0.0
+
+    @property
+    def rail_half_span(self) -> float:
+        """Half the rail wheel's width over its flanges [m], from its centre along the axle."""
+        return self.rail_w_wheel / 2.0 + RAIL_FLANGE_WIDTH if self.has_rail_wheel else 0.0
+
+    @property
+    def rail_clearance_offset(self) -> float:
+        """The least ``rail_offset`` [m] that keeps the rail wheel and its flanges beside the tyre, not
+        in it: half the tyre's width and the rail wheel's half span over its flanges."""
+        return self.w_wheel / 2.0 + self.rail_half_span if self.has_rail_wheel else 0.0
 
 
 @dataclass(frozen=True)
@@ -376,6 +413,9 @@ class RobotConfig:
                 "max_wheel_torque": d.max_wheel_torque,
                 "max_wheel_rate": d.max_wheel_rate,
                 "max_steering_torque": d.max_steering_torque,
+                "rail_wheel": d.has_rail_wheel,
+                "rail_flange_radius": d.rail_flange_radius,
+                "rail_flange_width": RAIL_FLANGE_WIDTH,
             }
         for b in self.batteries:
             out["batteries"][b.name]["derived"] = {"present": b.present}

@@ -12,7 +12,7 @@ import copy
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Callable, Dict, Iterable, Mapping, Optional, Tuple
+from typing import Callable, Dict, Iterable, List, Mapping, Optional, Tuple
 
 from thorvald_model.datum import Datum, parse_datum
 from thorvald_model.errors import ConfigError
@@ -186,14 +186,32 @@ def link_tree(xml: str) -> Dict[str, ParentJoint]:
         raise DescriptionError(str(e)) from None
 
 
+# The collisions the generator names for a drive's rail wheel (thorvald_model's wheel macro: a tread
+# between two flanges, paper 3.1's double wheels): not the tyre, so left as generated.
+RAIL_WHEEL_COLLISIONS = ("rail_tread", "rail_flange")
+
+
+def tyre_cylinders(link: ET.Element) -> List[ET.Element]:
+    """The collision cylinders of a wheel link that are its tyre's (and its hub's), not those of a
+    rail wheel on its axle (collisions named as :data:`RAIL_WHEEL_COLLISIONS`)."""
+    return [
+        cylinder
+        for collision in link.findall("collision")
+        if collision.get("name") not in RAIL_WHEEL_COLLISIONS
+        for cylinder in collision.findall("geometry/cylinder")
+    ]
+
+
 def with_tyre_contact(xml: str, wheel_joints: Iterable[str], width: float) -> str:
-    """The URDF with the collision cylinders of the given wheels' links narrowed to width [m].
+    """The URDF with the tyres' collision cylinders of the given wheels' links narrowed to width [m].
 
     pybullet touches a cylinder lying on a plane at one rim, not across its width, so a wheel's
     contact lies half its collision width beside the wheel's centre line: 8 cm for a 0.16 m wheel,
     enough to turn a differential robot's arcs 3 % tight and walk a spinning robot off its spot. A
     thin disc puts the contact within width / 2 of the centre line, where a crowned tyre's patch
-    is. The visual shapes, masses and inertias stay as they are.
+    is. The visual shapes, masses and inertias stay as they are, and so does a rail wheel on the
+    axle (:func:`tyre_cylinders`): its tread is as wide as a pipe's top needs, and its flanges must
+    reach either side of the pipe where they are.
     """
     root = ET.fromstring(xml)
     narrow_tyres(root, wheel_joints, width)
@@ -207,14 +225,15 @@ def narrow_tyres(root: ET.Element, wheel_joints: Iterable[str], width: float) ->
     for link in root.findall("link"):
         if link.get("name") not in wheel_links:
             continue
-        for cylinder in link.findall("collision/geometry/cylinder"):
+        for cylinder in tyre_cylinders(link):
             cylinder.set("length", repr(min(float(cylinder.get("length")), width)))
 
 
 def with_wheel_radii(xml: str, radii: Mapping[str, float]) -> str:
-    """The URDF with the collision cylinders of the given wheels' links ({wheel joint: radius [m]})
-    of another radius: an as-built robot's true rolling radii. The visuals, masses and inertias, and
-    what the description says of the drives, stay as configured."""
+    """The URDF with the tyres' collision cylinders of the given wheels' links ({wheel joint: radius
+    [m]}) of another radius: an as-built robot's true rolling radii. The visuals, masses and
+    inertias, a rail wheel on the axle (:func:`tyre_cylinders`), and what the description says of
+    the drives, stay as configured."""
     if not radii:
         return xml
     root = ET.fromstring(xml)
@@ -227,7 +246,7 @@ def set_wheel_radii(root: ET.Element, radii: Mapping[str, float]) -> None:
     links = {j.find("child").get("link"): radii[j.get("name")] for j in root.findall("joint") if j.get("name") in radii}
     for link in root.findall("link"):
         if link.get("name") in links:
-            for cylinder in link.findall("collision/geometry/cylinder"):
+            for cylinder in tyre_cylinders(link):
                 cylinder.set("radius", repr(links[link.get("name")]))
 
 

@@ -13,10 +13,11 @@ from .gradeability import GRADEABILITY
 from .headland import HEADLAND
 from .kind import ScenarioKind, not_applicable
 from .obstacle import OBSTACLE
+from .rails import RAILS
 from .side_slope import SIDE_SLOPE
 from .turning import TURNING
 
-BUILT_IN: Tuple[ScenarioKind, ...] = (GRADEABILITY, SIDE_SLOPE, TURNING, HEADLAND, OBSTACLE, DRAWBAR, ENERGY)
+BUILT_IN: Tuple[ScenarioKind, ...] = (GRADEABILITY, SIDE_SLOPE, TURNING, HEADLAND, OBSTACLE, DRAWBAR, RAILS, ENERGY)
 SCENARIOS: Dict[str, ScenarioKind] = {kind.name: kind for kind in BUILT_IN}
 
 __all__ = ["BUILT_IN", "SCENARIOS", "ScenarioKind", "not_applicable"]

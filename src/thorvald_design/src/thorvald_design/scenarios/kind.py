@@ -52,6 +52,11 @@ class Session(Protocol):
 
     def push(self, force: Optional[Sequence[float]], at: Sequence[float] = (0.0, 0.0, 0.0)) -> None: ...
 
+    def set_drive_params(self, changes: Sequence[Tuple[int, str, float]]) -> List[str]: ...
+
+    @property
+    def odometry(self) -> List[Any]: ...  # base_driver's odometry samples (t, x, y, yaw) in the odom frame
+
 
 class Lab(Protocol):
     def session(
