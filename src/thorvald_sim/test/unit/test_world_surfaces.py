@@ -46,6 +46,7 @@ TABLE = {
     "mud": (0.35, 0.2, 0.04, 0.015),
     "sand": (0.5, 0.25, 0.05, 0.02),
     "ice": (0.1, 0.01, 0.002, 0.0),
+    "soil": (0.6, 0.08, 0.016, 0.006),
 }
 SOFT = [kind for kind, numbers in TABLE.items() if numbers[3] > 0]
 

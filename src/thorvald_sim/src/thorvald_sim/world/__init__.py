@@ -41,17 +41,18 @@ wet_grass     0.3       0.08   0.016            0.008     wet grass, a field in 
 mud           0.35      0.2    0.04             0.015     wet, soft soil: a rutted gateway, a track
 sand          0.5       0.25   0.05             0.02      dry loose sand
 ice           0.1       0.01   0.002            0         ice, or wet plastic sheeting
+soil          0.6       0.08   0.016            0.006     bare field soil, tilled and settled
 ============  ========  =====  ===============  ========  ==========================================
 
 - ``lateral_friction`` is the tyre's peak grip, the friction coefficient of pybullet's Coulomb
   cone in every direction, from the middle of the published ranges: dry asphalt and concrete 0.7
   to 1.0 (tarmac 0.9 as this file's default ground, concrete a little smoother), loose gravel 0.5
-  to 0.7, dry grass 0.45 to 0.65, wet grass 0.2 to 0.4, wet clay and mud 0.2 to 0.5, dry sand 0.4
-  to 0.6, ice 0.05 to 0.15.
+  to 0.7, dry grass 0.45 to 0.65, dry field soil 0.5 to 0.7, wet grass 0.2 to 0.4, wet clay and
+  mud 0.2 to 0.5, dry sand 0.4 to 0.6, ice 0.05 to 0.15.
 - ``rolling_friction`` [m] is pybullet's rolling resistance: a torque against the wheel's turning of
   this times the normal force, so it is the coefficient of rolling resistance C_rr times the wheel's
   radius. C_rr (the middle of the published ranges: tyres on asphalt 0.01 to 0.02, on concrete
-  0.01 to 0.015, on gravel 0.02 to 0.08, on grass and firm field soil 0.05 to 0.1, on wet grass
+  0.01 to 0.015, on gravel 0.02 to 0.08, on grass and firm field soil 0.05 to 0.1 (bare tilled soil 0.08), on wet grass
   about 0.08, in soft wet soil 0.1 to 0.3, in loose sand 0.15 to 0.3, on ice about 0.01) times the
   Thorvald wheel's 0.2 m. A wheel of another radius r feels C_rr * 0.2 / r: a caster of 0.1 m
   rolls twice as hard. It costs the drive motors torque (the motors hold their speed, so it shows

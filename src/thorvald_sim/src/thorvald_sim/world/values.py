@@ -95,6 +95,7 @@ SURFACE_KINDS: Dict[str, SurfaceKind] = {
     "mud": SurfaceKind(0.35, 0.2, 0.04, 0.015, (0.38, 0.28, 0.18, 1.0), "wet, soft soil"),
     "sand": SurfaceKind(0.5, 0.25, 0.05, 0.02, (0.82, 0.73, 0.52, 1.0), "dry loose sand"),
     "ice": SurfaceKind(0.1, 0.01, 0.002, 0.0, RGBA_ICE, "ice, or wet plastic sheeting"),
+    "soil": SurfaceKind(0.6, 0.08, 0.016, 0.006, (0.45, 0.34, 0.24, 1.0), "bare field soil, tilled and settled"),
 }
 
 
