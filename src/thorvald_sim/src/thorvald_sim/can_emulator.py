@@ -24,12 +24,16 @@ from typing import Dict, List, Optional
 import can
 import cantools
 
+from thorvald_model.schema import keys_of
+from thorvald_model.values import Battery
+
 TPDO1_PERIOD = 0.02  # [s] speeds and counts
 TPDO2_PERIOD = 0.1  # [s] amps and power; TPDO3 status
 STATUS_PERIOD = 1.0  # [s] TPDO4 (homing setup, script, PPRs), heartbeat, batteries, IO states
 SCRIPT_VERSION = (2, 1, 0)  # major, minor, patch the emulated script reports
-NOMINAL_VOLTS = 48.0
-CAPACITY_AH = 100.0
+BATTERY_KEYS = {k.name: k for k in keys_of(Battery)}  # the robot file's battery keys, their defaults
+EMPTY_VOLTS = 44.0 / 48.0  # of a pack's nominal voltage when empty (a 48 V lithium pack: 44 V)
+FULL_VOLTS = 54.0 / 48.0  # and when full (54 V)
 RX_MESSAGES = {0x200: "Roboteq_RxPDO1", 0x300: "Roboteq_RxPDO2", 0x400: "Roboteq_RxPDO3", 0x500: "Roboteq_RxPDO4"}
 
 
@@ -108,6 +112,8 @@ class EmulatedController:
 @dataclass
 class EmulatedBattery:
     id: int
+    capacity: float  # [Ah] the robot file's (batteries.batN.capacity)
+    voltage: float  # [V] nominal, the robot file's
     state_of_charge: float = 95.0  # [%]
     current: float = 0.0  # [A], negative discharging
     alarms: int = 0
@@ -136,7 +142,9 @@ class CanEmulator:
             c.node: EmulatedController(c.node, [EmulatedDrive(d) for d in c.drives], c.steered)
             for c in config.motor_controllers
         }
-        self.batteries = {b.id: EmulatedBattery(b.id) for b in config.present_batteries}
+        self.batteries = {b.id: EmulatedBattery(b.id, b.capacity, b.voltage) for b in config.present_batteries}
+        # what the motor controllers read as their supply without a battery on the bus: the enclosures' nominal
+        self.nominal_volts = config.batteries[0].voltage if config.batteries else BATTERY_KEYS["voltage"].default
         self.ios = {b.id: EmulatedIo(b.id, b.type, [False, False]) for b in config.io_boards_on_bus}
         self.to_corrupt = 0
         self.sent = 0
@@ -370,14 +378,16 @@ class CanEmulator:
 
     def _battery_volts(self) -> float:
         if not self.batteries:
-            return NOMINAL_VOLTS
-        soc = min(b.state_of_charge for b in self.batteries.values())
-        return 44.0 + 10.0 * soc / 100.0  # 44 V empty, 54 V full
+            return self.nominal_volts
+        weakest = min(self.batteries.values(), key=lambda b: b.state_of_charge)
+        # a lithium pack between empty and full, linear in its charge: 44 V to 54 V for a 48 V pack
+        share = weakest.state_of_charge / 100.0
+        return weakest.voltage * (EMPTY_VOLTS + (FULL_VOLTS - EMPTY_VOLTS) * share)
 
     def _battery(self, b: EmulatedBattery, dt: float) -> None:
         draw = sum(self._amps(ch) for c in self.controllers.values() for ch in c.channels) / max(1, len(self.batteries))
         b.current = -draw
-        b.state_of_charge = max(0.0, b.state_of_charge - draw * dt / 3600.0 / CAPACITY_AH * 100.0)
+        b.state_of_charge = max(0.0, b.state_of_charge - draw * dt / 3600.0 / b.capacity * 100.0)
         base = b.id
         volts = self._battery_volts()
         alarms = {s.name: 0 for s in self._messages["Battery_TPDO1"].signals if s.length == 1 and "fet" not in s.name}
@@ -407,7 +417,7 @@ class CanEmulator:
                 "state_of_charge": int(b.state_of_charge),
                 "state_of_health": 97,
                 "cycle_count": 42,
-                "capacity": CAPACITY_AH,
+                "capacity": b.capacity,
             },
         )
 

@@ -86,6 +86,22 @@ def test_the_drives_follow_commands_through_the_bus(std):
     assert battery.state == 0 and 40 < battery.voltage < 60 and battery.state_of_charge > 90
 
 
+def test_the_battery_is_the_robot_files():
+    """A 24 V pack of 50 Ah (the robot file's batteries.bat0 capacity and voltage) reports its capacity
+    and a voltage in its own range (22 to 27 V for 24 V: 44 to 54 V for 48 V scaled)."""
+    with open(STD, encoding="utf-8") as f:
+        data = yaml.safe_load(f)
+    data["batteries"]["bat0"].update(capacity=50.0, voltage=24.0)
+    handle, emulator = pair(parse_robot_config(data, "24 V robot"))
+    try:
+        t, _ = run(handle, emulator, [DriveCommand(0.0, 0.0)] * 4, 0.0, 1.5)
+        (battery,) = handle.batteries(t)
+        assert battery.capacity == pytest.approx(50.0) and 22.0 < battery.voltage < 27.0
+    finally:
+        handle.close()
+        emulator.drop_bus()
+
+
 def test_ramps_come_from_the_configuration(std):
     _, handle, emulator = std
     _, states = run(handle, emulator, [DriveCommand(0.0, 1.0)] * 4, 0.0, 0.2)
