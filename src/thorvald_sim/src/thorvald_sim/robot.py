@@ -327,6 +327,15 @@ class SimRobot:
             out.append(MotorLoad(w[3], w[1], s[3], s[1]))
         return out
 
+    def wheel_loads(self) -> List[float]:
+        """[N] the normal force the world puts on each drive's wheel at the last step (its contact
+        points' sum; 0 for a wheel off the ground): how a rigid frame's weight is shared."""
+        loads = []
+        for joint, _, _ in self.wheels:
+            contacts = p.getContactPoints(self.body, linkIndexA=joint, physicsClientId=self.client)
+            loads.append(float(sum(cp[9] for cp in contacts)))
+        return loads
+
     def joint_states(self, joints: Sequence[int]) -> List[Tuple[float, float]]:
         """(position, velocity) of the given joint indices."""
         return [tuple(s[:2]) for s in p.getJointStates(self.body, list(joints), physicsClientId=self.client)]

@@ -405,6 +405,32 @@ def test_a_ball_resting_on_a_soft_patch_sinks_by_its_load_times_the_sinkage_and_
     assert r - track[tarmac][-1][0][2] < 1e-4
 
 
+def test_a_hill_of_a_surface_kind_has_its_grip_and_sinks_by_its_sinkage(client):
+    # a hill names a kind as the ground and patches do; a key of its own overrides the kind's; a hill
+    # of none is rigid tarmac-like ground (0.9) as before
+    hill = {"x": 0.0, "y": 0.0, "width": 4.0, "angle": 0.2, "height": 0.5, "top_length": 4.0}
+    world = parse_world({"slopes": {
+        "slope0": dict(hill, surface="mud"),
+        "slope1": dict(hill, y=10.0, surface="grass", lateral_friction=0.7, sinkage=0.01),
+        "slope2": dict(hill, y=-10.0),
+    }})  # fmt: skip
+    mud, grass, plain = (s.surface for s in world.slopes)
+    assert (mud.lateral_friction, mud.sinkage, mud.kind) == (0.35, 0.015, "mud")
+    assert (grass.lateral_friction, grass.rolling_friction, grass.sinkage) == (0.7, 0.012, 0.01)
+    assert (plain.lateral_friction, plain.sinkage, plain.soft) == (0.9, 0.0, False)
+    scene = build_scene(client, world)
+    assert p.getDynamicsInfo(scene.bodies["slopes.slope0"], -1, physicsClientId=client)[9] == pytest.approx(
+        500.0 / 0.015
+    )
+    # the reference load resting on the mud hill's level top sinks by the sinkage, as on a patch
+    r = 0.2
+    ball = _ball(client, (0.0, 0.0, 0.5 + r), SINKAGE_LOAD / G)
+    for _ in range(round(2.0 / DT)):
+        p.stepSimulation(physicsClientId=client)
+    z = p.getBasePositionAndOrientation(ball, physicsClientId=client)[0][2]
+    assert 0.5 + r - z == pytest.approx(0.015, abs=1e-4)
+
+
 def _robot(sim, x=0.0, y=0.0, yaw=0.0):
     robot = sim.spawn("r", std_urdf(), Pose2D(x, y, 0.0, yaw))
     return robot

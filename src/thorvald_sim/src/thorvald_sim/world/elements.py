@@ -24,7 +24,16 @@ from .budgets import (
     _wall_steps,
 )
 from .geometry import SOFT_PATCH_REACH, _along
-from .keys import MESH_EXTENSIONS, SHAPE_KEYS, SURFACE_DEFAULTS, ZERO_HINT, _kind_colour, _surface, _surface_of
+from .keys import (
+    MESH_EXTENSIONS,
+    SHAPE_KEYS,
+    SLOPE_DEFAULTS,
+    SURFACE_DEFAULTS,
+    ZERO_HINT,
+    _kind_colour,
+    _surface,
+    _surface_of,
+)
 from .kind import Context, Entry
 from .terrain import _image_levels, _noise_lattice
 from .values import (
@@ -88,7 +97,7 @@ def _slope(entry: Entry, context: Context) -> Slope:
     v = entry.values
     return Slope(
         entry.name, entry.index, v["x"], v["y"], v["yaw"], v["width"], v["angle"], v["height"], v["top_length"],
-        _surface(v),
+        _surface_of(v, SLOPE_DEFAULTS),
     )  # fmt: skip
 
 

@@ -84,8 +84,9 @@ SLOPE_KEYS = (
     Key("angle", float, check=lambda v: 0.0 < v <= MAX_SLOPE_ANGLE, rule=f"must be in (0, {MAX_SLOPE_ANGLE}] [rad]"),
     Key("height", float, **LENGTH),
     Key("top_length", float, 0.0, **LENGTH_OR_ZERO),
-    *_frictions(0.9),
+    *SURFACE_KEYS,
 )
+SLOPE_DEFAULTS = {**SURFACE_DEFAULTS, "lateral_friction": 0.9}
 
 RAIL_KEYS = (
     Key("x", float, **COORDINATE),

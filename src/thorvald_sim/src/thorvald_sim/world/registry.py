@@ -84,7 +84,11 @@ BUILT_IN: Tuple[ElementKind, ...] = (
     ElementKind(
         "slopes", "slope", SLOPE_KEYS, make=_slope, builder="build_slope", budget=bodies_each(), on_ground=False,
         footprint=footprints.slope, counted=("hill", "hills"),
-        doc="hills along their own x axis: a ramp up, a flat top, a ramp down",
+        doc="hills along their own x axis: a ramp up, a flat top, a ramp down (a soft one sinks under a wheel)",
+        defaults={
+            "surface": "none", "lateral_friction": "the surface kind's, else 0.9",
+            "rolling_friction": SURFACE_NUMBER, "spinning_friction": SURFACE_NUMBER, "sinkage": SURFACE_NUMBER,
+        },
     ),
     ElementKind(
         "rails", "rail", RAIL_KEYS, make=_rail, builder="build_rail", budget=bodies_each(2.0), check=_rails_check,
