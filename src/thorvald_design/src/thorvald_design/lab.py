@@ -65,6 +65,10 @@ class LabSession:
     def motor_loads(self) -> List[MotorLoad]:
         return self._session.robot.motor_torques()
 
+    def wheel_loads(self) -> List[float]:
+        """[N] the ground's normal force on each drive's wheel, in drive order."""
+        return self._session.robot.wheel_loads()
+
     def push(self, force: Optional[Sequence[float]], at: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
         self._session.push(force, at)
 

@@ -50,6 +50,7 @@ TRACKS = "tracks"
 # Whether more of a metric is better (+1) or less (-1): the table's bold, the Pareto front's directions
 DIRECTIONS: Dict[str, int] = {
     "max_climb_deg": +1,
+    "max_crest_deg": +1,
     "max_descent_deg": +1,
     "max_traverse_deg": +1,
     "static_overturning_deg": +1,
@@ -113,8 +114,14 @@ def why_not(value: Any) -> str:
     return str(value)
 
 
+def direction(metric: str) -> int:
+    """+1 when more of a metric is better, -1 when less is, 0 for words; a metric of one surface of
+    several (``max_pull_n.mud``) is its metric's."""
+    return DIRECTIONS.get(metric.split(".", 1)[0], 0)
+
+
 def direction_word(metric: str) -> str:
-    return {+1: "larger is better", -1: "smaller is better"}.get(DIRECTIONS.get(metric, 0), "")
+    return {+1: "larger is better", -1: "smaller is better"}.get(direction(metric), "")
 
 
 @dataclass(frozen=True)
@@ -133,7 +140,7 @@ class Metric:
 
     @property
     def direction(self) -> int:
-        return DIRECTIONS.get(self.name, 0)
+        return direction(self.name)
 
     def value(self, candidate: str) -> Any:
         return dict(self.values).get(candidate)
@@ -233,7 +240,7 @@ def check_pareto(pareto: Tuple[str, str], study: Study) -> None:
     for column in pareto:
         if column not in known:
             raise ValueError(f"pareto: {column!r} is not a column of this study's results: {', '.join(known)}")
-        if column.split(".", 1)[1] not in DIRECTIONS:
+        if not direction(column.split(".", 1)[1]):
             raise ValueError(f"pareto: {column!r} is not a metric with a better direction (DIRECTIONS)")
 
 

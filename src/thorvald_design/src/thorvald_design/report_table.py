@@ -8,7 +8,7 @@ from .scenarios import SCENARIOS
 
 
 def columns(study) -> List[str]:
-    return [f"{s}.{m}" for s, _ in study.scenarios for m in SCENARIOS[s].results]
+    return [f"{s}.{m}" for s, params in study.scenarios for m in SCENARIOS[s].columns(params)]
 
 
 def rows(results: Mapping[str, Any], study) -> List[List[Any]]:

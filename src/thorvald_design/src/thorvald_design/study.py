@@ -167,7 +167,7 @@ def parse_study(data: Any, source: str = "<study>", base_dir: str = ".", text: s
         candidates=raw_candidates if isinstance(raw_candidates, Mapping) else None,
         scenarios=[name for name, _ in scenarios],
     )
-    pareto = _pareto(data.get("pareto", MISSING), [name for name, _ in scenarios], problems)
+    pareto = _pareto(data.get("pareto", MISSING), scenarios, problems)
     searched = spec.candidate if spec is not None else None
     spaces: List[Space] = []
     candidates = _candidates(raw_candidates, base_dir, problems, searched, spaces)
@@ -179,7 +179,9 @@ def parse_study(data: Any, source: str = "<study>", base_dir: str = ".", text: s
     )
 
 
-def _pareto(raw: Any, scenarios: List[str], problems: List[Problem]) -> Optional[Tuple[str, str]]:
+def _pareto(
+    raw: Any, scenarios: Sequence[Tuple[str, Mapping[str, Any]]], problems: List[Problem]
+) -> Optional[Tuple[str, str]]:
     """``pareto: [SCENARIO.METRIC, SCENARIO.METRIC]``: the two metrics the report's Pareto plot compares."""
     if raw is MISSING or raw is None:
         return None
@@ -187,7 +189,7 @@ def _pareto(raw: Any, scenarios: List[str], problems: List[Problem]) -> Optional
     if not isinstance(raw, Sequence) or isinstance(raw, str) or len(raw) != 2:
         problems.append(Problem("pareto", short(raw), rule))
         return None
-    known = [f"{s}.{m}" for s in scenarios for m in SCENARIOS[s].results]
+    known = [f"{s}.{m}" for s, params in scenarios for m in SCENARIOS[s].columns(params)]
     found = len(problems)
     for k, column in enumerate(raw):
         if column not in known:

@@ -5,6 +5,7 @@ import textwrap
 import pytest
 import yaml
 
+from thorvald_design.report_table import columns
 from thorvald_design.study import MAX_CANDIDATES, load_study, parse_study
 from thorvald_model.config import parse_robot_config
 from thorvald_model.errors import ConfigError
@@ -93,6 +94,18 @@ def test_a_robot_file_is_found_from_the_study_files_folder(tmp_path):
          "scenarios.gradeability.surfce: 'mud': unknown key (did you mean 'surface'?)"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {gradeability: {surface: lava}}",
          "scenarios.gradeability.surface: 'lava': must be one of tarmac"),
+        ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {drawbar: {surfaces: [grass, lava]}}",
+         "scenarios.drawbar.surfaces: ['grass', 'lava']: must be one of tarmac"),
+        ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {drawbar: {surfaces: [mud, mud]}}",
+         "or a list of them (each once)"),
+        ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {drawbar: {surface: 3}}",
+         "scenarios.drawbar.surface: 3: must be a string or a list of strings"),
+        ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {drawbar: {surface: []}}",
+         "scenarios.drawbar.surface: []: must be a string or a list of strings"),
+        ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {drawbar: {surfaces: [mud]}}\n"
+         "pareto: [drawbar.max_pull_n.mud, drawbar.max_pull_n]",
+         "pareto[0]: 'drawbar.max_pull_n.mud': is not a metric of the study's scenarios (did you mean "
+         "'drawbar.max_pull_n'?)"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {gradeability: {start_deg: 30, max_deg: 20}}",
          "scenarios.gradeability.max_deg: 20.0: must be >= start_deg (30)"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_sdt}}\nscenarios: {turning: {}}",
@@ -154,3 +167,23 @@ def test_a_sweep_too_large_for_a_machine_is_refused():
         "scenarios: {turning: {}}"
     )
     assert f"candidates.a.sweep: <missing>: the sweep makes 272 candidates: at most {MAX_CANDIDATES}" in text
+
+
+def test_drawbar_takes_one_surface_or_several_and_each_has_its_columns():
+    one = parse_study(
+        yaml.safe_load("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {drawbar: {surface: mud}}")
+    )
+    several = parse_study(
+        yaml.safe_load(
+            "candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {drawbar: {surfaces: [tarmac, mud]}}\n"
+            "pareto: [drawbar.max_pull_n.mud, drawbar.max_pull_n.tarmac]"
+        )
+    )
+    assert dict(one.scenarios)["drawbar"]["surface"] == ("mud",)
+    assert dict(several.scenarios)["drawbar"]["surface"] == ("tarmac", "mud")
+    assert columns(one) == ["drawbar.max_pull_n", "drawbar.limited_by", "drawbar.predicted_pull_n", "drawbar.surface"]
+    assert columns(several)[4:] == [
+        "drawbar.max_pull_n.tarmac", "drawbar.limited_by.tarmac", "drawbar.predicted_pull_n.tarmac",
+        "drawbar.max_pull_n.mud", "drawbar.limited_by.mud", "drawbar.predicted_pull_n.mud",
+    ]  # fmt: skip
+    assert several.pareto == ("drawbar.max_pull_n.mud", "drawbar.max_pull_n.tarmac")

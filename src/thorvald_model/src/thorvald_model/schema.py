@@ -29,7 +29,7 @@ class Key:
     """One key of a section entry: its type, default, rule and aliases."""
 
     name: str
-    kind: type  # float, int, bool or str
+    kind: type  # float, int, bool, str, or tuple (of strings: one or a list of them)
     default: Any = REQUIRED
     check: Optional[Callable[[Any], bool]] = None
     rule: str = ""
@@ -409,13 +409,24 @@ def parse_scalar(data: Mapping, key: Key, problems: List[Problem]) -> Any:
     return values[key.name] if values else key.default
 
 
-KIND_NAMES = {float: "a finite number", int: "an integer", bool: "true or false (or 1 or 0)", str: "a string"}
+KIND_NAMES = {
+    float: "a finite number",
+    int: "an integer",
+    bool: "true or false (or 1 or 0)",
+    str: "a string",
+    tuple: "a string or a list of strings",
+}
 
 
 def coerce(value: Any, kind: type) -> Tuple[bool, Any]:
     """Converts a YAML value to kind; numbers written as strings ("-0.425") count as numbers."""
     if kind is str:
         return (True, value) if isinstance(value, str) else (False, None)
+    if kind is tuple:  # one or more names: a string is a list of one; the list holds strings only
+        items = [value] if isinstance(value, str) else value
+        if isinstance(items, (list, tuple)) and items and all(isinstance(v, str) for v in items):
+            return True, tuple(items)
+        return False, None
     if kind is bool:
         if isinstance(value, bool):
             return True, value

@@ -1,14 +1,17 @@
-"""drawbar: the largest pull the robot holds at walking speed (the Thorvald II hardware paper's
-traction trial).
+"""drawbar: the largest pull the robot holds at walking speed on each surface (the Thorvald II hardware
+paper's traction trial).
 
-Procedure: on level ground of the study's surface the robot drives straight ahead at ``speed``
-[m/s] (its heading held); after ``settle`` [s] a horizontal pull backwards acts on the frame at
-``hitch_height`` [m] above the ground behind base_link, growing by ``step_n`` [N] every ``hold_s``
-[s]. A pull is held when the robot's mean speed over the last second of its step is at least
-``held_speed`` (90 % by default) of the command. ``max_pull_n`` is the largest held: past it the
-driven wheels slip (traction) or their motors are at their torque limit (motor torque), as
-``limited_by`` says (the motors' mean share of their limit over that last second, as
-:mod:`~thorvald_design.scenarios.gradeability` decides it).
+Procedure: on level ground of each of the study's surfaces (``surface``: one kind or a list of them,
+``surfaces`` as well) the robot drives straight ahead at ``speed`` [m/s] (its heading held); after
+``settle`` [s] a horizontal pull backwards acts on the frame at ``hitch_height`` [m] above the
+ground behind base_link, growing by ``step_n`` [N] every ``hold_s`` [s]. A pull is held when the
+robot's mean speed over the last second of its step is at least ``held_speed`` (90 % by default) of
+the command. ``max_pull_n`` is the largest held: past it the driven wheels slip (traction) or their
+motors are at their torque limit (motor torque), as ``limited_by`` says (the motors' mean share of
+their limit over that last second, as :mod:`~thorvald_design.scenarios.gradeability` decides it).
+``max_pull_n``, ``limited_by`` and ``predicted_pull_n`` are the first surface's (``surface`` says
+which); with more than one surface, ``max_pull_n.KIND``, ``limited_by.KIND`` and
+``predicted_pull_n.KIND`` give every surface's, each in its own column of the table.
 
 What it must agree with: at constant speed on level ground the driven wheels' forces balance the
 pull and the rolling resistance: sum_driven min(mu N_i, F_i) = P + C_rr W, the loads N_i shifted
@@ -17,16 +20,23 @@ rearwards by the pull's moment P h about the contacts
 """
 
 import math
-from typing import Any, Dict, List, Mapping
+from typing import Any, Dict, List, Mapping, Tuple
 
-from thorvald_model.schema import Key, one_of
+from thorvald_model.schema import Key
 
 from .driving import SURFACE_RULE, SURFACES, flat_world, heading_hold, mean
 from .gradeability import TORQUE_BOUND
 from .kind import ScenarioKind
 
 KEYS = (
-    Key("surface", str, "grass", check=one_of(*SURFACES), rule=SURFACE_RULE),
+    Key(
+        "surface",
+        tuple,
+        ("grass",),
+        check=lambda kinds: all(k in SURFACES for k in kinds) and len(set(kinds)) == len(kinds),
+        rule=SURFACE_RULE + ", or a list of them (each once)",
+        aliases=("surfaces",),
+    ),
     Key("speed", float, 1.0, check=lambda v: 0.05 <= v <= 3.0, rule="must be in [0.05, 3] [m/s]"),
     Key("hitch_height", float, 0.4, check=lambda v: 0.0 <= v <= 3.0, rule="must be in [0, 3] [m]"),
     Key("step_n", float, 50.0, check=lambda v: 1.0 <= v <= 10000.0, rule="must be in [1, 10000] [N]"),
@@ -34,16 +44,32 @@ KEYS = (
     Key("settle", float, 3.0, check=lambda v: 0.5 <= v <= 30.0, rule="must be in [0.5, 30] [s]"),
     Key("held_speed", float, 0.9, check=lambda v: 0.1 <= v < 1.0, rule="must be in [0.1, 1)"),
 )
-RESULTS = ("max_pull_n", "limited_by", "predicted_pull_n")
+RESULTS = ("max_pull_n", "limited_by", "predicted_pull_n", "surface")
+EACH = ("max_pull_n", "limited_by", "predicted_pull_n")  # per surface, when there are several
 MAX_STEPS = 400  # of the pull: a robot holding 400 steps is out of the scenario's range
 
 
+def more(params: Mapping[str, Any]) -> Tuple[str, ...]:
+    """Every surface's metrics, when the study lists more than one."""
+    kinds = params["surface"]
+    return tuple(f"{metric}.{kind}" for kind in kinds for metric in EACH) if len(kinds) > 1 else ()
+
+
 def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
-    surface, speed = params["surface"], params["speed"]
+    kinds = params["surface"]
+    pulls = {kind: _pull(lab, design, params, kind) for kind in kinds}
+    result = dict(pulls[kinds[0]])
+    if len(kinds) > 1:
+        result.update({f"{metric}.{kind}": pulls[kind][metric] for kind in kinds for metric in EACH})
+    return result
+
+
+def _pull(lab, design, params: Mapping[str, Any], surface: str) -> Dict[str, Any]:
+    speed = params["speed"]
     predicted = design.pull_limit(surface, params["hitch_height"])
     held, limited_by = 0.0, f"none up to {MAX_STEPS * params['step_n']:g} N"
     loads: List[tuple] = []
-    with lab.session(flat_world(surface), label="pull") as session:
+    with lab.session(flat_world(surface), label=f"pull on {surface}") as session:
         command = heading_hold(session, 0.0, speed)
         session.run(params["settle"], command)
         for k in range(1, MAX_STEPS + 1):
@@ -81,8 +107,9 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
 
 DRAWBAR = ScenarioKind(
     name="drawbar",
-    what="the largest pull held at walking speed on a surface, and what limited it",
+    what="the largest pull held at walking speed on each surface, and what limited it",
     keys=KEYS,
     results=RESULTS,
     procedure=procedure,
+    more=more,
 )

@@ -37,8 +37,9 @@ def flat_world(surface: str, description: str = "") -> Dict:
 
 def ramp_world(surface: str, angle: float, run: float, top: float, width: float = 10.0) -> Dict:
     """A hill along +x whose foot is at x = 0: it climbs at angle [rad] over a horizontal run [m], stays
-    level for top [m] and comes down the same way; its faces and the ground are of the surface kind
-    (a ramp is rigid: the kind's friction and rolling resistance, not its sinkage)."""
+    level for top [m] and comes down the same way; its faces and the ground are of the surface kind,
+    its sinkage included: a soft ramp shares a rigid frame's weight among all its wheels, as tyres and
+    turf do (on a rigid one, a robot of more than three wheels stands on whichever three touch)."""
     footprint = 2.0 * run + top
     return {
         "description": f"a {math.degrees(angle):.1f} degree ramp of {surface}",
@@ -46,7 +47,7 @@ def ramp_world(surface: str, angle: float, run: float, top: float, width: float 
         "slopes": {
             "slope0": {
                 "x": footprint / 2.0, "y": 0.0, "yaw": 0.0, "width": width, "angle": angle,
-                "height": run * math.tan(angle), "top_length": top, **surface_keys(surface),
+                "height": run * math.tan(angle), "top_length": top, "surface": surface,
             }
         },
     }  # fmt: skip

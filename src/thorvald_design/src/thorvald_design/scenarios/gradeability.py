@@ -4,17 +4,24 @@ Procedure: ramps of increasing angle (``start_deg``, then every ``step_deg`` up 
 a hill of the study's surface whose foot is 0.5 m ahead of the robot's front, climbing over
 ``ramp_length`` [m] of run (at least twice the robot's length and 1 m) to a level top. The robot is
 commanded straight ahead at ``speed`` [m/s] (its own base_driver core, the heading held). A climb
-succeeds when base_link is on the top; it fails when the robot stalls (less than 3 cm gained in
-2 s), slides back (10 cm back from the furthest point it reached), tips (rolled or pitched 25
-degrees more than the ramp), or runs out of time (twice the time the climb takes at speed, and
-10 s). The series stops at the first failure: ``max_climb_deg`` is the steepest climbed,
-``limited_by`` what stopped the next:
+succeeds when the foremost wheel reaches the crest (the whole robot has climbed the incline); it
+fails when the robot stalls (less than 3 cm gained in 2 s), slides back (10 cm back from the
+furthest point it reached), tips (rolled or pitched 25 degrees more than the ramp), or runs out of
+time (twice the time the climb takes at speed, and 10 s). The series stops at the first failure:
+``max_climb_deg`` is the steepest climbed, ``limited_by`` what stopped the next:
 
 - ``tipping`` when it tipped;
-- ``motor torque`` when the driven wheels' motors were at their torque limit (on average over the
-  last second at least 95 % of it): they cannot turn the wheels any harder, the wheels do not slip;
+- ``motor torque`` when the driven wheels that push (those above 10 % of their torque limit: a
+  wheel off the ground turns freely) were at their torque limit (on average over the last second
+  at least 95 % of it): they cannot turn the wheels any harder, the wheels do not slip;
 - ``traction`` otherwise: the wheels turn below their torque limit, so the ground gives no more
   grip: they slip.
+
+The crest is another obstacle: after the incline the robot drives on until base_link is over the
+top. A frame on more than two axles bridges a sharp crest on its middle wheels (the front and rear
+ones lift off, as at a vehicle's ramp breakover angle), which then carry the whole robot on their
+own motors; ``max_crest_deg`` is the steepest ramp whose crest it crossed too (every gentler one
+crossed as well). Each try in ``climbs`` is ``[angle, incline, crest]``.
 
 Descent: from the level top of each ramp the robot drives down the far side at ``speed``; it is
 under control when its speed along the ramp stays within ``max(0.1, 0.3 * speed)`` m/s of the
@@ -32,7 +39,7 @@ simulated climb, a dynamic drive at speed, reaches it to within a step.
 """
 
 import math
-from typing import Any, Dict, List, Mapping
+from typing import Any, Dict, List, Mapping, Tuple
 
 from thorvald_model.schema import Key, one_of
 
@@ -51,6 +58,7 @@ from .driving import (
 from .kind import ScenarioKind
 
 TORQUE_BOUND = 0.95  # of the motors' torque limit, on average over the last second: the motors are the limit
+PUSHING = 0.1  # of its torque limit: below this a wheel is not pushing (it is off the ground)
 SPEED_WINDOW = 0.5  # [s] a descent's speed is measured over
 SETTLE = 1.0  # [s] the robot stands before it is commanded (it settles on its suspension)
 
@@ -67,6 +75,7 @@ RESULTS = (
     "surface",
     "max_climb_deg",
     "limited_by",
+    "max_crest_deg",
     "max_descent_deg",
     "predicted_climb_deg",
     "predicted_limited_by",
@@ -91,15 +100,18 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
         "predicted_limited_by": limits.limited_by,
         "predicted_descent_deg": round(math.degrees(limits.descent), 2),
     }
-    climbed, limited_by, tries = 0.0, f"none up to {params['max_deg']:g} deg", []
+    climbed, crested, crest_held = 0.0, 0.0, True
+    limited_by, tries = f"none up to {params['max_deg']:g} deg", []
     for angle in angles(params):
-        outcome = _climb(lab, design, params, math.radians(angle))
-        tries.append([angle, outcome])
+        outcome, over = _climb(lab, design, params, math.radians(angle))
+        tries.append([angle, outcome, over])
         if outcome != "ok":
             limited_by = outcome
             break
         climbed = angle
-    result.update(max_climb_deg=climbed, limited_by=limited_by, climbs=tries)
+        crest_held = crest_held and over == "ok"
+        crested = angle if crest_held else crested
+    result.update(max_climb_deg=climbed, limited_by=limited_by, max_crest_deg=crested, climbs=tries)
     descended, tries = 0.0, []
     if params["descent"]:
         for angle in angles(params):
@@ -119,11 +131,13 @@ def ramp_run(design, params) -> float:
     return max(params["ramp_length"], 2.0 * design.length + 1.0)
 
 
-def _climb(lab, design, params, angle: float) -> str:
+def _climb(lab, design, params, angle: float) -> Tuple[str, str]:
+    """Climbs one ramp: (the incline's outcome, the crest's), "ok" or what stopped it."""
     run, speed = ramp_run(design, params), params["speed"]
     top = design.length + 1.0
     world = ramp_world(params["surface"], angle, run, top)
     start_x = -(design.front + 0.5)  # the robot's front 0.5 m short of the foot
+    crest = run - design.front * math.cos(angle)  # base_link where the foremost wheel reaches the crest
     goal = run + 0.5 * top  # base_link over the middle of the top
     limit = SETTLE + 2.0 * (goal - start_x) / speed + 10.0
     progress = Progress(slope=angle)
@@ -137,8 +151,11 @@ def _climb(lab, design, params, angle: float) -> str:
             return s.track[-1].x >= goal or progress.failed(s.track)
 
         session.run(limit, command, stop)
-        session.outcome = _climb_outcome(session.track[-1].x >= goal, progress, loads, design)
-    return session.outcome
+        furthest = max(pose.x for pose in session.track)
+        outcome = _climb_outcome(furthest >= crest, progress, loads, design)
+        over = _climb_outcome(session.track[-1].x >= goal, progress, loads, design) if outcome == "ok" else outcome
+        session.outcome = outcome if over == "ok" else f"{outcome}; the crest: {over}"
+    return outcome, over
 
 
 def _climb_outcome(reached: bool, progress: Progress, loads, design) -> str:
@@ -146,10 +163,12 @@ def _climb_outcome(reached: bool, progress: Progress, loads, design) -> str:
         return "ok"
     if progress.outcome == "tipping":
         return "tipping"
-    # what held it: the motors at their limit, or the ground's grip (the wheels turn below it)
+    # what held it: the motors at their limit, or the ground's grip (the wheels turn below it); a
+    # wheel off the ground (a long frame bridging a crest) turns freely and is not one that pushes
     last = [torques for t, torques in loads if t >= loads[-1][0] - 1.0]
-    share = mean([mean([tq / m for tq, m in zip(torques, design.max_wheel_torques) if m > 0]) for torques in last])
-    return "motor torque" if share >= TORQUE_BOUND else "traction"
+    shares = [tq / m for torques in last for tq, m in zip(torques, design.max_wheel_torques) if m > 0]
+    pushing = [share for share in shares if share >= PUSHING]
+    return "motor torque" if pushing and mean(pushing) >= TORQUE_BOUND else "traction"
 
 
 def _descend(lab, design, params, angle: float) -> str:

@@ -87,6 +87,13 @@ class ScenarioKind:
     procedure: Callable[[Lab, Any, Mapping[str, Any]], Dict[str, Any]]
     # the rules between its parameters: problems appended at path.KEY
     check: Callable[[Mapping[str, Any], str, List[Problem]], None] = field(default=lambda values, path, problems: None)
+    # the metrics a study's parameters give beyond ``results`` (drawbar's ``max_pull_n.mud`` for each
+    # further surface): the table's, the CSV's and the report's columns after ``results``
+    more: Callable[[Mapping[str, Any]], Tuple[str, ...]] = field(default=lambda params: ())
+
+    def columns(self, params: Mapping[str, Any]) -> Tuple[str, ...]:
+        """The metrics a run of these parameters reports, in the table's order."""
+        return (*self.results, *self.more(params))
 
 
 def not_applicable(why: str) -> str:

@@ -29,7 +29,7 @@ from typing import Any, Dict, Mapping
 from thorvald_model.schema import Key, one_of
 
 from ..metrics import lateral_drift
-from .driving import SURFACE_RULE, SURFACES, Progress, check_series, heading_hold, surface_keys, track_of
+from .driving import SURFACE_RULE, SURFACES, Progress, check_series, heading_hold, track_of
 from .gradeability import SETTLE, angles
 from .kind import ScenarioKind
 
@@ -50,7 +50,7 @@ check = check_series("start_deg", "max_deg")
 
 def side_slope_world(surface: str, angle: float, run: float, length: float) -> Dict:
     """A hill whose face rises towards +y from its foot at y = 0 over a horizontal run [m], length [m]
-    along x (centred on x = 0), a level top as wide as the run, of the surface kind."""
+    along x (centred on x = 0), a level top as wide as the run, of the surface kind (its sinkage too)."""
     top = run
     footprint = 2.0 * run + top
     return {
@@ -59,7 +59,7 @@ def side_slope_world(surface: str, angle: float, run: float, length: float) -> D
         "slopes": {
             "slope0": {
                 "x": 0.0, "y": footprint / 2.0, "yaw": math.pi / 2.0, "width": length, "angle": angle,
-                "height": run * math.tan(angle), "top_length": top, **surface_keys(surface),
+                "height": run * math.tan(angle), "top_length": top, "surface": surface,
             }
         },
     }  # fmt: skip
