@@ -469,7 +469,7 @@ def sweep_front(
         and all(_number(metrics.get(m)) for m, _ in spec.objectives)
     ]
     vectors = [[float(points[i][1][m]) for m, _ in spec.objectives] for i in feasible]
-    front = tuple(feasible[j] for j in _front(vectors, [d for _, d in spec.objectives]))
+    front = tuple(feasible[j] for j in pareto_front(vectors, _signs(spec.objectives)))
     if runs is None:
         runs = sum(len({name.split(".")[0] for name in metrics}) for _, metrics in points)
     return SweepFront(
@@ -494,17 +494,45 @@ def full_sweep(spec: OptimiseSpec, space: Space, evaluate: Evaluate, scenario_or
     return sweep_front(spec, points, runs=len(points) * len(scenario_order))
 
 
-def _front(points: Sequence[Sequence[float]], directions: Sequence[str]) -> Tuple[int, ...]:
-    """The indices of the points no other point dominates (at least as good in every objective and
-    better in one), in order; directions: "max" or "min" an objective. Equal points are all kept."""
-    return tuple(i for i, p in enumerate(points) if not any(_dominates(o, p, directions) for o in points))
+SIGNS = {"max": +1, "min": -1}  # an objective's direction as pareto_front's
 
 
-def _dominates(a: Sequence[float], b: Sequence[float], directions: Sequence[str]) -> bool:
-    """Whether point a dominates point b: at least as good in every objective, better in one."""
-    signs = [1.0 if d == "min" else -1.0 for d in directions]
-    costs = [(s * x, s * y) for s, x, y in zip(signs, a, b)]
-    return all(x <= y for x, y in costs) and any(x < y for x, y in costs)
+def pareto_front(points: Sequence[Sequence[float]], directions: Sequence[int]) -> List[int]:
+    """The indices (ascending) of the points no other point dominates: the one Pareto front of the
+    package (the search's, the sweep's, the report's plot).
+
+    directions: per coordinate, +1 if larger is better, -1 if smaller is. A point dominates another
+    when it is at least as good in every coordinate and better in one; equal points dominate neither,
+    so both are on the front. ValueError for a direction not +-1, a point of another length than the
+    directions, or a coordinate that is not a finite number.
+    """
+    if any(d not in (1, -1) for d in directions):
+        raise ValueError(f"directions must be +1 or -1, not {list(directions)}")
+    scored = []
+    for i, point in enumerate(points):
+        if len(point) != len(directions):
+            raise ValueError(f"point {i} has {len(point)} coordinates, the directions {len(directions)}")
+        if not all(_finite(v) for v in point):
+            raise ValueError(f"point {i} is not finite numbers: {list(point)}")
+        scored.append(tuple(d * float(v) for d, v in zip(directions, point)))
+    return [i for i, p in enumerate(scored) if not any(_better(q, p) for q in scored)]
+
+
+def dominates(a: Sequence[float], b: Sequence[float], directions: Sequence[int]) -> bool:
+    """Whether point a dominates point b (directions as :func:`pareto_front`'s)."""
+    return _better([d * x for d, x in zip(directions, a)], [d * y for d, y in zip(directions, b)])
+
+
+def _better(a: Sequence[float], b: Sequence[float]) -> bool:
+    return all(x >= y for x, y in zip(a, b)) and any(x > y for x, y in zip(a, b))
+
+
+def _finite(value: Any) -> bool:
+    return not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
+
+
+def _signs(objectives: Sequence[Tuple[str, str]]) -> List[int]:
+    return [SIGNS[d] for _, d in objectives]
 
 
 def compare(optimised: OptimiseResult, full: SweepFront) -> Dict[str, Any]:
@@ -516,7 +544,7 @@ def compare(optimised: OptimiseResult, full: SweepFront) -> Dict[str, Any]:
     the search took for the front for want of a better one)."""
     if optimised.objectives != full.objectives:
         raise ValueError("compare: the search and the sweep have different objectives")
-    directions = [d for _, d in full.objectives]
+    directions = _signs(full.objectives)
     names = [m for m, _ in full.objectives]
     found_points = [optimised.trials[n] for n in optimised.front]
     found_values = {t.values for t in found_points}
@@ -536,7 +564,7 @@ def compare(optimised: OptimiseResult, full: SweepFront) -> Dict[str, Any]:
         nearest = min(math.sqrt(sum(((a - b) / s) ** 2 for a, b, s in zip(vector, f, scales))) for f in found_vectors)
         distances.append(nearest)
     known = [d for d in distances if d is not None]
-    dominated = sum(any(_dominates(f, v, directions) for f in front_vectors) for v in found_vectors)
+    dominated = sum(any(dominates(f, v, directions) for f in front_vectors) for v in found_vectors)
     return {
         "runs": {"search": optimised.runs, "sweep": full.runs, "saved_by_pruning": optimised.saved},
         "trials": {
@@ -565,9 +593,11 @@ __all__ = [
     "SweepFront",
     "Trial",
     "compare",
+    "dominates",
     "full_sweep",
     "grid",
     "optimise",
+    "pareto_front",
     "parse_optimise",
     "parse_range",
     "sweep_front",

@@ -14,8 +14,9 @@ counter of loaded images): a study's results are passed around as a file and ope
 farm, so nothing it needs may be elsewhere; the same inputs give the same bytes (no dates, no
 random ids), so a report is compared and kept like any other result.
 
-Pure: what is plotted (:func:`metrics`, :func:`sweeps`, :func:`pareto_plane`), the Pareto front
-(:func:`pareto_front`), the plan of a world (:func:`world_map`) and the page (:func:`page_html`).
+Pure: what is plotted (:func:`metrics`, :func:`sweeps`, :func:`pareto_plane`: its front is
+:func:`thorvald_design.optimise.pareto_front`, the package's one), the plan of a world
+(:func:`world_map`) and the page (:func:`page_html`).
 Writing: the plots (matplotlib's Agg canvas, no pyplot) and the page (:func:`write_report`).
 """
 
@@ -37,6 +38,7 @@ from matplotlib.patches import Circle, Polygon
 from thorvald_model.errors import ThorvaldModelError
 from thorvald_sim.world import element_kinds, parse_world, plant_positions
 
+from .optimise import pareto_front
 from .report_table import _text, columns, rows
 from .runs import safe_name
 from .scenarios import SCENARIOS
@@ -197,30 +199,6 @@ def combination(key_paths: Sequence[str], values: Sequence[float]) -> str:
 
 
 # ---- Pareto front ------------------------------------------------------------------------------------
-def pareto_front(points: Sequence[Sequence[float]], directions: Sequence[int]) -> List[int]:
-    """The indices (ascending) of the points no other point dominates.
-
-    directions: per coordinate, +1 if larger is better, -1 if smaller is. A point dominates another
-    when it is at least as good in every coordinate and better in one; equal points dominate neither,
-    so both are on the front. ValueError for a direction not +-1, a point of another length than the
-    directions, or a coordinate that is not a finite number.
-    """
-    if any(d not in (1, -1) for d in directions):
-        raise ValueError(f"directions must be +1 or -1, not {list(directions)}")
-    scored = []
-    for i, point in enumerate(points):
-        if len(point) != len(directions):
-            raise ValueError(f"point {i} has {len(point)} coordinates, the directions {len(directions)}")
-        if not all(number(v) is not None for v in point):
-            raise ValueError(f"point {i} is not finite numbers: {list(point)}")
-        scored.append(tuple(d * float(v) for d, v in zip(directions, point)))
-
-    def dominates(a: Sequence[float], b: Sequence[float]) -> bool:
-        return all(x >= y for x, y in zip(a, b)) and any(x > y for x, y in zip(a, b))
-
-    return [i for i, p in enumerate(scored) if not any(dominates(q, p) for q in scored)]
-
-
 @dataclass(frozen=True)
 class ParetoPlane:
     """Every candidate with numbers for both columns, which of them are the front, and the others."""
@@ -1003,7 +981,6 @@ __all__ = [
     "WorldMap",
     "metrics",
     "page_html",
-    "pareto_front",
     "pareto_plane",
     "parse_tracks",
     "sweeps",

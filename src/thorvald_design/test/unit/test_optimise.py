@@ -26,11 +26,11 @@ from thorvald_design.optimise import (
     Range,
     Requirement,
     Trial,
-    _front,
     compare,
     full_sweep,
     grid,
     optimise,
+    pareto_front,
     parse_optimise,
     parse_range,
 )
@@ -286,7 +286,7 @@ def test_a_smaller_search_finds_points_no_tried_combination_dominates():
     result = optimise(spec(8), SPACE, Synthetic(), ORDER, seed=1)
     complete = [t.objectives for t in result.trials if t.state == "complete"]
     found = [result.trials[n].objectives for n in result.front]
-    assert set(_front(complete, ["max", "min"])) == {complete.index(v) for v in found}
+    assert set(pareto_front(complete, [1, -1])) == {complete.index(v) for v in found}
 
 
 def test_a_range_is_searched_between_its_bounds():
@@ -318,10 +318,10 @@ def test_a_result_is_plain_json():
 # ---- the front and the comparison ---------------------------------------------------------------------
 def test_the_front_keeps_what_nothing_dominates():
     points = [(1.0, 1.0), (2.0, 2.0), (2.0, 1.0), (2.0, 1.0), (0.5, 0.5)]
-    assert _front(points, ["max", "min"]) == (2, 3, 4)  # (2, 1) beats (1, 1) and (2, 2); equal ones both stay
-    assert _front(points, ["min", "min"]) == (4,)
-    assert _front([(1, 2, 3), (1, 2, 4), (0, 5, 5)], ["min", "min", "max"]) == (1, 2)
-    assert _front([], ["max", "min"]) == ()
+    assert pareto_front(points, [1, -1]) == [2, 3, 4]  # (2, 1) beats (1, 1) and (2, 2); equal ones both stay
+    assert pareto_front(points, [-1, -1]) == [4]
+    assert pareto_front([(1, 2, 3), (1, 2, 4), (0, 5, 5)], [-1, -1, 1]) == [1, 2]
+    assert pareto_front([], [1, -1]) == []
 
 
 def test_a_full_sweep_runs_every_combination_and_finds_the_true_front():

@@ -18,13 +18,13 @@ from hypothesis import given
 from hypothesis import strategies as st
 from PIL import Image
 
+from thorvald_design.optimise import pareto_front
 from thorvald_design.report import (
     DIRECTIONS,
     TEXT_METRICS,
     best,
     convex_hull,
     metrics,
-    pareto_front,
     pareto_plane,
     parse_tracks,
     sweeps,
