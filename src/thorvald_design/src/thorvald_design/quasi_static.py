@@ -53,9 +53,23 @@ on any three-wheeler, the linear model's first zero load and the tipping point a
 a robot with three axles (6WD) the front axle lifts well before the robot tips (it then stands on two
 axles), so tipping is taken from the support polygon, never from the first zero load.
 
-Friction and motors: a driven wheel i gives at most min(mu N_i, F_i) of tangential force, F_i its
-motor's torque limit at the rim (max_wheel_torque / r_wheel); rolling resistance costs C_rr N_i on
-every wheel, C_rr Nz in all.
+Friction, rolling resistance and motors. Rolling resistance is a torque C_rr r N_i at each wheel
+against its rolling (the offset of a tyre's pressure under it; the simulator's rolling friction is
+exactly this): it costs the motors torque, not the ground grip. A wheel's tangential force T_i is
+bounded by the grip, |T_i| <= mu N_i; a driven wheel's motor gives T_i r + C_rr N_i r <= F_i r, F_i
+its torque limit at the rim (max_wheel_torque / r_wheel); a free wheel turns with T_i = -C_rr N_i.
+Driving, the driven wheels give at most min(mu N_i, F_i - C_rr N_i) each and the free wheels take
+C_rr N_i each, which reads, with C_rr N_i added on both sides,
+
+    sum_driven min((mu + C_rr) N_i, F_i) >= (what the task asks) + C_rr Nz
+
+the familiar sum with rolling resistance on every wheel, whose driven wheels' grip is mu + C_rr (the
+rolling resistance a driven wheel pays is its motor's, not its grip's). Braking (nose down) the
+torque helps the motor and not the grip: min((mu - C_rr) N_i, F_i) each against the slope's pull less
+C_rr Nz. Terramechanics' drawbar pull (thrust less motion resistance, both at the contact) is the
+other model, of a wheel sinking into soft soil; the simulator's wheels roll on springs and pay the
+rolling resistance as a torque, and a simulated pull agrees with this one (mud: mu W, not
+(mu - C_rr) W).
 
 Casters: :func:`layout_of` puts a caster's contact at its swivel axis (x, y). The wheel really
 trails the axis by caster_offset, behind it when the robot drives forward, so the real support
@@ -461,24 +475,35 @@ def _check_driven(layout: Layout) -> None:
         raise ValueError(f"no wheel of the layout is driven ({', '.join(c.name for c in layout.contacts)})")
 
 
-def _effort(layout: Layout, loads: Sequence[float], friction: float, grip: bool = True, torque: bool = True) -> float:
-    """sum over the driven wheels of min(mu N_i, F_i) [N] (grip False: F_i alone; torque False: mu N_i alone)."""
+def _driving(friction: float, rolling_resistance: float) -> float:
+    """The driven wheels' grip coefficient in the sums when they drive: mu + C_rr (the module's docstring)."""
+    return friction + rolling_resistance
+
+
+def _braking(friction: float, rolling_resistance: float) -> float:
+    """... and when they brake: mu - C_rr (none below 0)."""
+    return max(friction - rolling_resistance, 0.0)
+
+
+def _effort(layout: Layout, loads: Sequence[float], grip: float, friction: bool = True, torque: bool = True) -> float:
+    """sum over the driven wheels of min(grip N_i, F_i) [N], grip the coefficient of :func:`_driving` or
+    :func:`_braking` (friction False: F_i alone; torque False: grip N_i alone)."""
     total = 0.0
     for c, n in zip(layout.contacts, loads):
         if c.driven:
-            limits = ([friction * max(n, 0.0)] if grip else []) + ([c.max_force] if torque else [])
+            limits = ([grip * max(n, 0.0)] if friction else []) + ([c.max_force] if torque else [])
             total += min(limits)
     return total
 
 
-def _binding(layout: Layout, loads: Sequence[float], friction: float) -> str:
+def _binding(layout: Layout, loads: Sequence[float], grip: float) -> str:
     """Which bound the driven wheels' force at these loads: the one that limits the larger share of it."""
     by_grip = by_torque = 0.0
     for c, n in zip(layout.contacts, loads):
         if c.driven:
-            grip = friction * max(n, 0.0)
-            if grip <= c.max_force:
-                by_grip += grip
+            held = grip * max(n, 0.0)
+            if held <= c.max_force:
+                by_grip += held
             else:
                 by_torque += c.max_force
     return TRACTION if by_grip >= by_torque else TORQUE
@@ -547,16 +572,18 @@ def gradeability(
     the weight's component along it and the rolling resistance of every wheel (the statics: the
     tangential forces balance W sin(theta), the loads sum to W cos(theta)):
 
-        sum_driven min(mu N_i(theta), F_i) >= W sin(theta) + C_rr W cos(theta)
+        sum_driven min((mu + C_rr) N_i(theta), F_i) >= W sin(theta) + C_rr W cos(theta)
 
     with N_i the loads the wheels carry (:func:`contact_loads`; load moves to the rear as theta
-    grows: rear drive gains, front drive loses). traction drops the F_i, torque the mu N_i
-    (W (sin + C_rr cos) = sum F_i: theta = asin(sum F / (W sqrt(1 + C_rr^2))) - atan(C_rr)). tipping:
+    grows: rear drive gains, front drive loses) and mu + C_rr the driven wheels' grip in this sum
+    (the module's docstring: rolling resistance is a torque; every wheel driven, tan(theta) = mu).
+    traction drops the F_i, torque the grip (W (sin + C_rr cos) = sum F_i: theta = asin(sum F /
+    (W sqrt(1 + C_rr^2))) - atan(C_rr)). tipping:
     the centre of pressure moves h tan(theta) back, out of the support polygon at tan(theta) = d / h,
     d the distance from the centre of mass back to its edge. Nose down, braking, the weight pulls
     down the slope and rolling resistance helps hold it:
 
-        sum_driven min(mu N_i(-theta), F_i) >= W sin(theta) - C_rr W cos(theta)
+        sum_driven min((mu - C_rr) N_i(-theta), F_i) >= W sin(theta) - C_rr W cos(theta)
 
     Each limit is the first theta where its condition fails, bracketed on a scan and bisected to
     1e-6 rad.
@@ -576,17 +603,18 @@ def gradeability(
     tipping = _tipping_slope(layout, -1.0, 0.0)  # climbing, it tips backwards: u = -x
     tipping_forward = _tipping_slope(layout, 1.0, 0.0)
 
-    climb = _first_failure(lambda t: _effort(layout, standing(t), friction) >= climbing(t), tipping, ANGLE_TOLERANCE)
+    drive, brake = _driving(friction, c_rr), _braking(friction, c_rr)
+    climb = _first_failure(lambda t: _effort(layout, standing(t), drive) >= climbing(t), tipping, ANGLE_TOLERANCE)
     if climb is None:
         climb, limited_by = tipping, TIPPING
     else:
-        limited_by = _binding(layout, standing(climb), friction)
+        limited_by = _binding(layout, standing(climb), drive)
 
     def held_loads(theta: float) -> Tuple[float, ...]:  # past tipping: the robot held onto the slope
         return standing(theta) if theta < tipping else normal_loads(layout, theta, gravity=gravity)
 
     traction = _first_failure(
-        lambda t: _effort(layout, held_loads(t), friction, torque=False) >= climbing(t), math.pi / 2, ANGLE_TOLERANCE
+        lambda t: _effort(layout, held_loads(t), drive, torque=False) >= climbing(t), math.pi / 2, ANGLE_TOLERANCE
     )
     motors = sum(c.max_force for c in layout.driven)
     torque = _first_failure(lambda t: motors >= climbing(t), math.pi / 2, ANGLE_TOLERANCE)
@@ -594,14 +622,14 @@ def gradeability(
     lift = _first_failure(lambda t: min(normal_loads(layout, t, gravity=gravity)) > 0.0, tipping, ANGLE_TOLERANCE)
 
     descent = _first_failure(
-        lambda t: _effort(layout, standing(-t), friction) >= w * (math.sin(t) - c_rr * math.cos(t)),
+        lambda t: _effort(layout, standing(-t), brake) >= w * (math.sin(t) - c_rr * math.cos(t)),
         tipping_forward,
         ANGLE_TOLERANCE,
     )
     if descent is None:
         descent, descent_limited_by = tipping_forward, TIPPING
     else:
-        descent_limited_by = _binding(layout, standing(-descent), friction)
+        descent_limited_by = _binding(layout, standing(-descent), brake)
 
     return GradeLimits(
         climb=climb,
@@ -630,12 +658,13 @@ def max_pull(
     layout: Layout, friction: float, rolling_resistance: float, pull_height: float, gravity: float = GRAVITY
 ) -> PullLimit:
     """The largest horizontal backward pull P at pull_height [m] that the driven wheels hold on level
-    ground at constant speed: sum_driven min(mu N_i(P), F_i) >= P + C_rr W.
+    ground at constant speed: sum_driven min((mu + C_rr) N_i(P), F_i) >= P + C_rr W (every wheel
+    driven and the motors strong enough: P = mu W).
 
     The pull moves load to the rear (My falls by P hp: the centre of pressure moves hp P / W back),
     which helps rear drive and lifts the front; the robot tips backwards at P = W d / hp, d the
     distance from the centre of mass back to the support polygon's edge. sum min(...) is at most
-    min(mu W, sum F_i), so the pull is too; the first failing pull is bracketed and bisected to 1e-6 N.
+    min((mu + C_rr) W, sum F_i), so the pull is too; the first failing pull is bracketed and bisected to 1e-6 N.
     ValueError if no wheel is driven, the robot cannot stand or pull_height < 0.
     """
     _check_surface(friction, rolling_resistance, gravity)
@@ -646,13 +675,14 @@ def max_pull(
     w = layout.weight(gravity)
     back = _distance_to_edge(layout, layout.com[0], layout.com[1], -1.0, 0.0)
     tipping = w * back / pull_height if pull_height > 0.0 else math.inf
-    cap = min(friction * w, sum(c.max_force for c in layout.driven))
+    drive = _driving(friction, rolling_resistance)
+    cap = min(drive * w, sum(c.max_force for c in layout.driven))
 
     def loads(pull: float) -> Tuple[float, ...]:
         return contact_loads(layout, 0.0, gravity=gravity, pull=pull, pull_height=pull_height)
 
     def holds(pull: float) -> bool:
-        return _effort(layout, loads(pull), friction) >= pull + rolling_resistance * w
+        return _effort(layout, loads(pull), drive) >= pull + rolling_resistance * w
 
     upper = min(tipping, cap)
     pull = _first_failure(holds, upper, FORCE_TOLERANCE)
@@ -660,7 +690,7 @@ def max_pull(
         if tipping <= cap:
             return PullLimit(tipping, TIPPING)
         pull = cap  # holds up to the cap, which no pull beyond can pass
-    return PullLimit(pull, _binding(layout, loads(pull), friction))
+    return PullLimit(pull, _binding(layout, loads(pull), drive))
 
 
 # ---- overturning -----------------------------------------------------------------------------------

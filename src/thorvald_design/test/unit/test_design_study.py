@@ -118,8 +118,9 @@ def test_the_pull_agrees_with_the_quasi_static_limit_on_each_surface(study):
         assert pull["surface"] == "grass" and pull["max_pull_n"] == pull["max_pull_n.grass"], (name, pull)
         for kind in ("grass", "tarmac"):
             held, predicted = pull[f"max_pull_n.{kind}"], pull[f"predicted_pull_n.{kind}"]
-            assert held <= predicted * 1.1 + 1.0, (name, kind, pull)
-            assert held + 100.0 >= predicted * 0.9, (name, kind, pull)
+            # held is a multiple of the 100 N step, the largest one held: within 5 % and a step of the limit
+            assert held <= predicted * 1.05 + 1.0, (name, kind, pull)
+            assert held + 100.0 >= predicted * 0.95, (name, kind, pull)
         # tarmac grips better than grass (0.9 against 0.55): it pulls more, up to its motors' limit
         assert pull["max_pull_n.tarmac"] > pull["max_pull_n.grass"], (name, pull)
         assert pull["predicted_pull_n.tarmac"] > pull["predicted_pull_n.grass"], (name, pull)

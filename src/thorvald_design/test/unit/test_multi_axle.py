@@ -72,12 +72,13 @@ def test_on_a_soft_incline_the_load_shifts_downhill_as_the_model_says():
 def test_six_wheels_climb_what_the_quasi_static_limit_says_and_their_crest_is_the_breakover():
     design = design_of(SIX, robot_file(SIX))
     params = {k.name: k.default for k in KEYS}
-    params.update(surface="grass", start_deg=24.0, step_deg=2.0, max_deg=26.0, descent=False)
+    params.update(surface="grass", start_deg=26.0, step_deg=2.0, max_deg=28.0, descent=False)
     result = GRADEABILITY.procedure(Lab(robot_file(SIX)), design, params)
-    assert result["predicted_climb_deg"] == pytest.approx(26.1, abs=0.1)
+    # every wheel driven, the grip holds the slope: tan(theta) = mu = 0.55 on grass
+    assert result["predicted_climb_deg"] == pytest.approx(math.degrees(math.atan(0.55)), abs=0.1)
     assert result["predicted_limited_by"] == "traction"
     # the incline itself: within a step of the limit (on a rigid ramp the same robot stalled at 16)
     assert result["max_climb_deg"] >= result["predicted_climb_deg"] - params["step_deg"]
     # the crest: the middle axle carries the whole robot there and its two motors cannot lift it
-    assert [c[:2] for c in result["climbs"]] == [[24.0, "ok"], [26.0, "ok"]]
+    assert [c[:2] for c in result["climbs"]] == [[26.0, "ok"], [28.0, "ok"]]
     assert result["climbs"][0][2] != "ok" and result["max_crest_deg"] == 0.0

@@ -211,13 +211,17 @@ def test_grade_limits_of_front_rear_and_all_wheel_drive_are_the_textbook_ones():
 
 
 def test_rolling_resistance_lowers_the_rear_drives_climb_as_its_closed_form_says():
-    # mu W (cos a + sin h) / L = W (sin + C cos) -> tan = (mu a - C L) / (L - mu h); off-centre, xc = 0.1
+    # the rear wheels grip mu N_r, the free front ones roll against C N_f (a torque at each wheel):
+    # mu W (a cos + h sin) / L - C W (b cos - h sin) / L = W sin -> tan = (mu a - C b) / (L - (mu + C) h);
+    # off-centre, xc = 0.1
     mu, c_rr, length, h = 0.7, 0.05, 1.0, 0.4
     a = 0.5 - 0.1  # from the front axle to the centre of mass
+    b = length - a
     limits = gradeability(two_axle("r", xc=0.1, h=h), mu, c_rr)
-    assert limits.climb == pytest.approx(math.atan((mu * a - c_rr * length) / (length - mu * h)), abs=TOL)
-    # braking downhill with all wheels, rolling resistance helps: mu cos = sin - C cos -> tan = mu + C
-    assert gradeability(two_axle("fr"), mu, c_rr).descent == pytest.approx(math.atan(mu + c_rr), abs=TOL)
+    assert limits.climb == pytest.approx(math.atan((mu * a - c_rr * b) / (length - (mu + c_rr) * h)), abs=TOL)
+    # braking downhill with all wheels: the grip holds the slope, mu cos = sin -> tan = mu (the
+    # rolling resistance helps the motors, not the grip)
+    assert gradeability(two_axle("fr"), mu, c_rr).descent == pytest.approx(math.atan(mu), abs=TOL)
 
 
 def test_weak_motors_limit_the_climb_to_where_their_force_carries_the_slope():
@@ -231,7 +235,7 @@ def test_weak_motors_limit_the_climb_to_where_their_force_carries_the_slope():
     assert limits.torque == pytest.approx(expected, abs=TOL)
     assert math.sin(limits.climb) + c_rr * math.cos(limits.climb) == pytest.approx(ratio, abs=1e-5)
     assert limits.limited_by == TORQUE
-    assert limits.traction == pytest.approx(math.atan(0.8 - c_rr), abs=1e-3)  # mu cos = sin + C cos
+    assert limits.traction == pytest.approx(math.atan(0.8), abs=1e-3)  # mu cos = sin: rolling costs the motors
 
 
 def test_a_tall_narrow_robot_tips_before_it_slips():
@@ -255,16 +259,18 @@ def test_when_the_motors_bind_at_the_rear_and_grip_at_the_front_the_climb_is_bel
 
 # ---- drawbar pull ----------------------------------------------------------------------------------
 def test_the_rear_drives_pull_gains_from_the_load_it_moves_to_the_rear():
-    # level ground: N_r = (W a + P hp) / L; mu N_r = P + C W -> P = (mu W a / L - C W) / (1 - mu hp / L)
+    # level ground: N_r = (W a + P hp) / L, N_f = (W b - P hp) / L; the rear grips mu N_r, the free
+    # front wheels roll against C N_f: mu N_r - C N_f = P -> P = (mu W a - C W b) / (L - (mu + C) hp)
     mu, c_rr, hp, a, length = 0.8, 0.02, 0.3, 0.5, 1.0
+    b = length - a
     w = 200.0 * G
     rear = max_pull(two_axle("r"), mu, c_rr, hp)
-    assert rear.pull == pytest.approx((mu * w * a / length - c_rr * w) / (1 - mu * hp / length), abs=1e-3)
+    assert rear.pull == pytest.approx((mu * w * a - c_rr * w * b) / (length - (mu + c_rr) * hp), abs=1e-3)
     assert rear.limited_by == TRACTION
-    front = max_pull(two_axle("f"), mu, c_rr, hp)  # loses load: mu (W b - P hp) / L = P + C W
-    assert front.pull == pytest.approx((mu * w * 0.5 / length - c_rr * w) / (1 + mu * hp / length), abs=1e-3)
-    all_wheel = max_pull(two_axle("fr"), mu, c_rr, hp)  # the load moves, the sum stays: mu W - C W
-    assert all_wheel.pull == pytest.approx((mu - c_rr) * w, abs=1e-3)
+    front = max_pull(two_axle("f"), mu, c_rr, hp)  # loses load: mu N_f - C N_r = P
+    assert front.pull == pytest.approx((mu * w * b - c_rr * w * a) / (length + (mu + c_rr) * hp), abs=1e-3)
+    all_wheel = max_pull(two_axle("fr"), mu, c_rr, hp)  # the load moves, the sum stays: mu W
+    assert all_wheel.pull == pytest.approx(mu * w, abs=1e-3)
 
 
 def test_a_high_pull_tips_the_robot_and_weak_motors_cap_it():

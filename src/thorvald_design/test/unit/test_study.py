@@ -1,5 +1,6 @@
 """thorvald_design.study: a study file read and checked as a robot file is (pure)."""
 
+import os
 import textwrap
 
 import pytest
@@ -187,3 +188,14 @@ def test_drawbar_takes_one_surface_or_several_and_each_has_its_columns():
         "drawbar.max_pull_n.mud", "drawbar.limited_by.mud", "drawbar.predicted_pull_n.mud",
     ]  # fmt: skip
     assert several.pareto == ("drawbar.max_pull_n.mud", "drawbar.max_pull_n.tarmac")
+
+
+STUDIES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "studies")
+
+
+@pytest.mark.parametrize("name", sorted(f for f in os.listdir(STUDIES) if f.endswith(".yaml")))
+def test_every_shipped_study_is_a_valid_study_with_its_command_in_its_header(name):
+    path = os.path.join(STUDIES, name)
+    study = load_study(path)
+    assert study.candidates and study.scenarios
+    assert f"studies/{name} --out /tmp/{name[:-5]}" in study.text  # the comment a user copies
