@@ -24,6 +24,7 @@ import sys
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Tuple
 
+import numpy as np
 import rosbag
 
 from thorvald_model import ConfigError, load_robot_config
@@ -35,6 +36,7 @@ from .calibration import (
     Calibration,
     DriveRecording,
     GnssTruth,
+    ObservableFit,
     OdometryError,
     PoseTruth,
     as_read_with,
@@ -42,6 +44,7 @@ from .calibration import (
     calibration_yaml,
     load_calibration,
     local_metres,
+    observable_fit,
     odometry_error,
     set_drive_params_command,
 )
@@ -151,6 +154,14 @@ def parse_args(argv: Optional[List[str]]):
     parser.add_argument(
         "--out", default="", help="the calibration file to write (default: calibration.yaml beside the bag)"
     )
+    parser.add_argument(
+        "--fit",
+        choices=("drives", "odometry"),
+        default="drives",
+        help="drives: each drive's radius and offset from its own wheel's motion (the default); odometry: only "
+        "the combinations the drive determines through the odometry, the rest kept at the values in effect "
+        "(the simulator's ground truth)",
+    )
     parser.add_argument("--json", action="store_true", help="print the results as one JSON document")
     return parser.parse_args(argv)
 
@@ -174,7 +185,16 @@ def run(args) -> int:
         for index, key, value in earlier:
             in_effect = in_effect.with_drive_param(index, key, value)
     recording, truth, said, namespace = read_bag(args.bag, len(robot.drives), args.ground_truth, args.antenna)
-    calibration = calibrate(in_effect, recording, truth, window=args.window)
+    if args.fit == "odometry":
+        if not isinstance(truth, PoseTruth):
+            raise CalibrationError(
+                "--fit odometry: needs the simulator's ground truth (a body twist at every instant), not GNSS"
+            )
+        observable = observable_fit(in_effect, recording, truth)
+        calibration = observable.calibration(float(np.sum(np.abs(np.diff(truth.yaw)))))
+    else:
+        calibration = calibrate(in_effect, recording, truth, window=args.window)
+        observable = observable_fit(in_effect, recording, truth) if isinstance(truth, PoseTruth) else None
     calibrated = calibration.calibrated(in_effect)
     bias = calibration.heading_bias[0] if calibration.heading_bias else 0.0
     before = odometry_error(in_effect, recording, truth, bias)
@@ -182,7 +202,15 @@ def run(args) -> int:
     out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.bag)), "calibration.yaml")
     kept = write_file(out, calibration, earlier, args, said)
     outcome = Outcome(
-        calibration, said, before, after, out, set_drive_params_command(calibration.changes(), namespace), kept
+        calibration,
+        said,
+        before,
+        after,
+        out,
+        set_drive_params_command(calibration.changes(), namespace),
+        kept,
+        observable,
+        args.fit,
     )
     if args.json:
         print(json.dumps(as_json(outcome), indent=2))
@@ -200,6 +228,8 @@ class Outcome:
     path: str  # the calibration file written
     command: str  # the set_drive_params call
     kept: bool  # the file keeps values of the calibration in effect that were not estimated again
+    observable: Optional[ObservableFit] = None  # what the drive determines through the odometry (simulator)
+    fit: str = "drives"
 
 
 def write_file(path: str, calibration: Calibration, earlier, args, said: str) -> bool:
@@ -243,6 +273,17 @@ def as_json(outcome: Outcome) -> dict:
     }
     if calibration.heading_bias is not None:
         out["imu_yaw_bias"] = {"value": calibration.heading_bias[0], "sd": _number(calibration.heading_bias[1])}
+    out["fit"] = outcome.fit
+    if outcome.observable is not None:
+        out["combinations"] = [
+            {
+                "strength": c.strength,
+                "uncertainty_left": c.sd,
+                "determined": c.determined,
+                "parts": {name: weight for name, weight in c.parts},
+            }
+            for c in outcome.observable.combinations
+        ]
     return out
 
 
@@ -281,6 +322,16 @@ def print_text(outcome: Outcome) -> None:
         print(f"IMU yaw bias against east: {value:+.5f} ± {sd:.5f} rad ({math.degrees(value):+.3f} deg)")
     for p in calibration.not_excited:
         print(f"not excited: {p.drive} {p.key} (left at {p.in_effect:g}): {p.reason}")
+    fit = outcome.observable
+    if fit is not None:
+        print(
+            f"what the drive determines through the odometry: {len(fit.determined)} of {len(fit.combinations)} "
+            "combinations (in units of each parameter's prior uncertainty, 1 % of a radius and 0.5 deg of an offset)"
+        )
+        for c in fit.combinations:
+            print(f"  {c.describe()}")
+        if outcome.fit == "odometry":
+            print("fitted: the determined combinations; the others kept at the values in effect")
     print(
         f"odometry against ground truth: before {before.distance_error_percent:+.3f} % of "
         f"{before.truth_distance_m:.2f} m, end point {before.end_point_m:.3f} m; after "

@@ -101,6 +101,28 @@ def test_json_with_the_simulators_ground_truth(tmp_path, capsys, std):
     )
 
 
+def test_it_says_what_the_drive_determines_through_the_odometry_and_fits_only_that(tmp_path, capsys, std):
+    bag = write_bag(tmp_path / "straight.bag", synthetic_drive(std, STRAIGHT, RADII, OFFSETS))
+    status, out, err = run(capsys, bag, "--robot-model", STD)
+    assert status == 0, err
+    assert "what the drive determines through the odometry: 3 of 8 combinations" in out
+    assert out.count("(determined)") == 3 and out.count("(kept at the values in effect)") == 5
+    status, out, err = run(capsys, bag, "--robot-model", STD, "--fit", "odometry", "--json")
+    assert status == 0, err
+    result = json.loads(out)
+    assert result["fit"] == "odometry" and sum(c["determined"] for c in result["combinations"]) == 3
+    strongest = result["combinations"][0]["parts"]  # the common scale: every radius alike
+    assert sorted(strongest) == [f"drive{i}.r_wheel" for i in range(4)]
+    assert max(abs(w) for w in strongest.values()) - min(abs(w) for w in strongest.values()) < 0.05
+    # the odometry is right after it, though no single radius is each tyre's
+    assert result["after"]["end_point_m"] < 1e-3 < result["before"]["end_point_m"]
+    assert len(load_calibration(result["calibration_file"], std)) == 8
+    # GNSS has no body twist to compare at every instant: refused, one line
+    gnss = write_bag(tmp_path / "gnss.bag", synthetic_drive(std, STRAIGHT, RADII, OFFSETS), sim=False, gnss=True)
+    status, out, err = run(capsys, gnss, "--robot-model", STD, "--fit", "odometry")
+    assert status == 2 and err.count("\n") == 1 and "needs the simulator's ground truth" in err
+
+
 def test_text_with_gnss_on_a_straight_line_refuses_the_offsets(tmp_path, capsys, std):
     drive = synthetic_drive(std, STRAIGHT, RADII, OFFSETS, heading_bias=1.2, antenna=(0.3, 0.0))
     bag = write_bag(tmp_path / "straight.bag", drive, ns="", gnss=True)

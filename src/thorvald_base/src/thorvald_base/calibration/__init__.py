@@ -11,6 +11,8 @@ result as a file base_driver loads at start (``~calibration``) and reads it back
 
 * :mod:`.recording`: the recorded drive and ground truth as numbers;
 * :mod:`.estimate`: the model, the least squares, uncertainties and excitation;
+* :mod:`.observable`: which combinations a drive determines through the odometry, and a fit of
+  those alone, the rest kept at the values in effect;
 * :mod:`.odometry_error`: odometry against ground truth, before and after;
 * :mod:`.calibration_file`: the file base_driver loads, and the set_drive_params call.
 
@@ -35,6 +37,7 @@ from .estimate import (
     ParameterEstimate,
     calibrate,
 )
+from .observable import Combination, ObservableFit, observable_fit
 from .odometry_error import OdometryError, as_read_with, odometry_error, replay, truth_path
 from .recording import DriveRecording, GnssTruth, PoseTruth, local_metres
 
@@ -45,8 +48,10 @@ __all__ = [
     "SIMULATOR",
     "WINDOW",
     "Calibration",
+    "Combination",
     "DriveRecording",
     "GnssTruth",
+    "ObservableFit",
     "OdometryError",
     "ParameterEstimate",
     "PoseTruth",
@@ -56,6 +61,7 @@ __all__ = [
     "calibration_yaml",
     "load_calibration",
     "local_metres",
+    "observable_fit",
     "odometry_error",
     "parse_calibration",
     "replay",

@@ -129,6 +129,13 @@ class BaseCalculator:
     def zero_odometry_pose(self) -> None:
         self._pose = Pose()
 
+    def body_twist(self, steering: Sequence[float], speed: Sequence[float]) -> Twist:
+        """The body velocity odometry takes from these drive states (its estimator's), integrating
+        nothing: what a calibration compares with ground truth."""
+        self._require()
+        vx, vy, wz, _, _ = self._estimator.estimate(list(steering), list(speed))
+        return Twist(vx, vy, wz)
+
     # ---- conveniences ---------------------------------------------------------------------
     @classmethod
     def from_config(cls, config, **options) -> "BaseCalculator":
