@@ -29,7 +29,7 @@ import rosbag
 
 from thorvald_model import ConfigError, load_robot_config
 
-from .bag_topics import topics_by_ending
+from .bag_topics import lost_messages, lost_sentence, topics_by_ending
 from .calibration import (
     GNSS,
     WINDOW,
@@ -89,8 +89,10 @@ def read_bag(
             raise BagError(f"{path}: no ground truth: no topic ending in {wanted} (the bag has: {names})")
         wanted = [topics["states"]] + ([topics["fix"], topics["imu"]] if use_gnss else [topics["truth"]])
         states, poses, fixes, yaws = [], [], [], []
+        sequences: Dict[str, List[int]] = {}
         for topic, msg, _ in bag.read_messages(topics=wanted):
             stamp = msg.header.stamp.to_sec()
+            sequences.setdefault(topic, []).append(msg.header.seq)
             if topic == topics["states"]:
                 states.append((stamp, tuple(msg.steer_pos), tuple(msg.prop_speed)))
             elif topic == topics.get("truth"):
@@ -111,6 +113,12 @@ def read_bag(
                     fixes.append((stamp, msg.latitude, msg.longitude))
             else:
                 yaws.append((stamp, quaternion_yaw(msg.orientation)))
+    lost = lost_messages(sequences)
+    if lost:
+        raise BagError(
+            f"{path}: the recording is incomplete ({lost_sentence(lost)}): a reader fell behind and dropped "
+            "messages; record again"
+        )
     namespace = topics["states"][: -len(ENDINGS["states"])].rstrip("/")
     recording = DriveRecording.from_samples(states, drives)
     if use_gnss:

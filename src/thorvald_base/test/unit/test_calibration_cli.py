@@ -28,16 +28,20 @@ OFFSETS = (0.004, -0.006, 0.002, 0.007)
 LAT0, LON0 = 53.268642, -0.524509  # [deg] the Riseholme datum
 
 
-def write_bag(path, drive, *, ns="/robot_1", sim=True, gnss=False, states=True):
-    """The topics odometry_report records: base_state, odometry/gazebo, gps/fix, imu/data."""
+def write_bag(path, drive, *, ns="/robot_1", sim=True, gnss=False, states=True, lose=()):
+    """The topics odometry_report records: base_state, odometry/gazebo, gps/fix, imu/data; lose:
+    indices of base_state messages published (numbered, header.seq) and never recorded."""
     phi = math.radians(LAT0)
     w = 1.0 - WGS84_E2 * math.sin(phi) ** 2
     north_radius, east_radius = WGS84_A * (1 - WGS84_E2) / w**1.5, WGS84_A / math.sqrt(w) * math.cos(phi)
     with rosbag.Bag(str(path), "w") as bag:
         if states:
             rec = drive.recording
-            for t, steering, speed in zip(rec.t, rec.steering, rec.speed):
+            for seq, (t, steering, speed) in enumerate(zip(rec.t, rec.steering, rec.speed)):
+                if seq in lose:
+                    continue
                 msg = BaseState(steer_pos=list(steering), prop_speed=list(speed))
+                msg.header.seq = seq
                 msg.header.stamp = genpy.Time.from_sec(t)
                 bag.write(ns + "/base_state", msg, msg.header.stamp)
         if sim:
@@ -121,6 +125,13 @@ def test_it_says_what_the_drive_determines_through_the_odometry_and_fits_only_th
     gnss = write_bag(tmp_path / "gnss.bag", synthetic_drive(std, STRAIGHT, RADII, OFFSETS), sim=False, gnss=True)
     status, out, err = run(capsys, gnss, "--robot-model", STD, "--fit", "odometry")
     assert status == 2 and err.count("\n") == 1 and "needs the simulator's ground truth" in err
+
+
+def test_a_recording_that_lost_drive_states_is_refused(tmp_path, capsys, std):
+    bag = write_bag(tmp_path / "lost.bag", synthetic_drive(std, MIXED, RADII, OFFSETS), lose=(100,))
+    status, out, err = run(capsys, bag, "--robot-model", STD)
+    assert status == 2 and out == ""
+    assert "the recording is incomplete (/robot_1/base_state: 1 lost, the first seq 100)" in err
 
 
 def test_text_with_gnss_on_a_straight_line_refuses_the_offsets(tmp_path, capsys, std):

@@ -19,6 +19,7 @@ import math
 from dataclasses import dataclass, field
 from typing import List, Optional, Sequence, Tuple
 
+from thorvald_base.bag_topics import lost_messages, lost_sentence
 from thorvald_base.kinematics import DriveState
 from thorvald_model.datum import WGS84_A, WGS84_E2, earth_radii  # noqa: F401  (the constants: for tests)
 
@@ -74,6 +75,19 @@ class Recording:
     robot: str = ""
     source: str = ""  # the bag file
     gnss: Path = field(default_factory=Path)  # RTK-GNSS positions with the IMU's yaw (gnss_path); may be empty
+    sequences: dict = field(default_factory=dict)  # topic -> the header.seq of each message recorded
+
+
+def check_complete(recording: Recording) -> None:
+    """ReportError when a message the report reads was published and not recorded: every control
+    instant's drive states, odometry and ground truth must be in the bag, or the figures (the paper
+    estimator's replay above all) would silently differ from a complete recording's."""
+    lost = lost_messages(recording.sequences)
+    if lost:
+        raise ReportError(
+            f"{recording.source}: the recording is incomplete ({lost_sentence(lost)}): a reader fell behind "
+            "and dropped messages, so the figures would differ from a complete run's; record again"
+        )
 
 
 @dataclass(frozen=True)

@@ -201,11 +201,12 @@ def run(args) -> int:
     from thorvald_base.plugins import load_calculator  # noqa: PLC0415
     from thorvald_base.verification import commanded_path, plan_for  # noqa: PLC0415
 
-    from .odometry_report import PAPER_SEED, format_report, make_report  # noqa: PLC0415
+    from .odometry_report import PAPER_SEED, check_complete, format_report, make_report  # noqa: PLC0415
     from .report_bag import read_recording  # noqa: PLC0415
     from .report_plots import figure8, figure9  # noqa: PLC0415
 
     recording = read_recording(bag, robot=name)
+    check_complete(recording)
     drives = {len(s[1]) for s in recording.states}
     if drives != {len(config.drives)}:
         raise ReportError(

@@ -52,6 +52,8 @@ def read_recording(path: str, robot: str = "") -> Recording:
         wanted += [topics[k] for k in ("fix", "imu") if k in topics]
         fixes, yaws = [], []
         for topic, msg, stamp in bag.read_messages(topics=wanted):
+            if hasattr(msg, "header") and topic != command_topic:  # a publisher's count: the lost show
+                rec.sequences.setdefault(topic, []).append(msg.header.seq)
             if topic == topics.get("fix"):
                 if msg.status.status >= 0:  # a fix (STATUS_NO_FIX is -1)
                     fixes.append((msg.header.stamp.to_sec(), msg.latitude, msg.longitude))

@@ -12,7 +12,7 @@ from nav_msgs.msg import Odometry
 from report_test_helpers import robot, synthetic
 
 from thorvald_base.kinematics import Twist
-from thorvald_bringup.odometry_report import ReportError
+from thorvald_bringup.odometry_report import ReportError, check_complete
 from thorvald_bringup.report_bag import read_recording
 from thorvald_msgs.msg import BaseState
 
@@ -28,7 +28,8 @@ def odometry_msg(path, i):
     return msg
 
 
-def write_bag(path, rec, ns="/thorvald_001", skip=()):
+def write_bag(path, rec, ns="/thorvald_001", skip=(), lose=()):
+    """lose: indices of base_state messages published (numbered, header.seq) and never recorded."""
     with rosbag.Bag(str(path), "w") as bag:
         for t, vx, vy, wz in rec.commands:
             msg = TwistMsg()
@@ -41,8 +42,11 @@ def write_bag(path, rec, ns="/thorvald_001", skip=()):
                 for i in range(len(series)):
                     bag.write(f"{ns}/{topic}", odometry_msg(series, i), rospy.Time.from_sec(series.t[i] + 0.002))
         if "base_state" not in skip:
-            for t, steering, speed in rec.states:
+            for seq, (t, steering, speed) in enumerate(rec.states):
+                if seq in lose:
+                    continue
                 msg = BaseState()
+                msg.header.seq = seq
                 msg.header.stamp = rospy.Time.from_sec(t)
                 msg.steer_pos, msg.prop_speed = list(steering), list(speed)
                 msg.prop_pos, msg.steer_speed = [0.0] * len(speed), [0.0] * len(speed)
@@ -82,6 +86,21 @@ def test_a_bag_without_a_needed_topic_is_refused_naming_it(tmp_path, drive):
     (tmp_path / "junk.bag").write_bytes(b"not a bag")
     with pytest.raises(ReportError, match=r"junk\.bag: cannot read the bag"):
         read_recording(str(tmp_path / "junk.bag"))
+
+
+def test_a_recording_that_lost_a_message_the_report_reads_is_refused_naming_it(tmp_path, drive):
+    write_bag(tmp_path / "whole.bag", drive)
+    check_complete(read_recording(str(tmp_path / "whole.bag")))  # every message, numbered in order
+    write_bag(tmp_path / "lost.bag", drive, lose=(40, 41, 97))
+    rec = read_recording(str(tmp_path / "lost.bag"))
+    with pytest.raises(
+        ReportError,
+        match=r"lost\.bag: the recording is incomplete \(/thorvald_001/base_state: 3 lost, "
+        r"the first seq 40\)",
+    ):
+        check_complete(rec)
+    done = run_report("--bag", str(tmp_path / "lost.bag"), "--out", str(tmp_path / "report"))
+    assert done.returncode != 0 and "the recording is incomplete" in done.stderr and "Traceback" not in done.stderr
 
 
 def run_report(*args):
