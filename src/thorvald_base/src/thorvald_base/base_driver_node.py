@@ -88,6 +88,7 @@ from .lockstep import LockstepCycles, apply_calibration
 from .node_names import Names, Throttle
 from .params import PARAMETER_NAMES, DriverParams
 from .plugins import load_calculator
+from .publishing import BlockingPublisher
 from .stamped_commands import StampedCommands
 
 STATUS_PERIOD = 1.0  # [s] between battery_data / motor_controller_data messages
@@ -193,11 +194,17 @@ class BaseDriverNode:
         # Every cycle's odometry and states, also to a recorder on a loaded machine: rospy writes to each
         # reader from a thread of its own and drops the oldest message when its queue is full; with 10
         # (0.2 s at 50 Hz) a writer thread starved beside a busy core lost five base_state messages of a
-        # recorded drive, and the report replayed from them differed by 14 mm
-        self.odom_pub = rospy.Publisher(names.topic("odometry/base_raw"), Odometry, queue_size=RECORDED_QUEUE)
-        self.joint_pub = rospy.Publisher(names.topic("joint_states"), JointState, queue_size=RECORDED_QUEUE)
-        self.state_pub = rospy.Publisher(names.topic("base_state"), BaseState, queue_size=RECORDED_QUEUE)
-        self.command_pub = rospy.Publisher(names.topic("joint_commands"), BaseState, queue_size=RECORDED_QUEUE)
+        # recorded drive, and the report replayed from them differed by 14 mm. In lockstep nothing may be
+        # lost: the cycle waits for every reader (the world waits for the cycle anyway)
+        def recorded(topic, kind):
+            if self.lockstep:
+                return BlockingPublisher(names.topic(topic), kind)
+            return rospy.Publisher(names.topic(topic), kind, queue_size=RECORDED_QUEUE)
+
+        self.odom_pub = recorded("odometry/base_raw", Odometry)
+        self.joint_pub = recorded("joint_states", JointState)
+        self.state_pub = recorded("base_state", BaseState)
+        self.command_pub = recorded("joint_commands", BaseState)
         self.battery_pub = rospy.Publisher(names.topic("battery_data"), BatteryArray, queue_size=1)
         self.controller_pub = rospy.Publisher(names.topic("motor_controller_data"), ControllerArray, queue_size=1)
         self.io_pub = rospy.Publisher(names.topic("io_data"), IOArray, queue_size=1)

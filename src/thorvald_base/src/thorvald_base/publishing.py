@@ -9,6 +9,10 @@ rospy offers two ways to publish, and a fast loop that talks to many readers (th
 - ``queue_size=None`` writes in the publishing thread, but blocks it on a reader whose socket is
   full, e.g. one behind a dropped network link: the whole simulation stopped for every robot.
 
+``BlockingPublisher`` is the second, made for what a lockstep run records: a reader that falls
+behind holds the publisher back (through TCP) instead of missing messages, so nothing published is
+lost; in lockstep the world waits anyway, and a run then repeats to the bit under any load.
+
 ``NonBlockingPublisher`` writes in the publishing thread on non-blocking sockets. A reader whose
 socket is full (its kernel buffers hold everything it has not read yet: on a dropped link after
 some seconds) misses the messages published meanwhile, with a throttled warning, and gets the next
@@ -23,6 +27,21 @@ import rospy
 from rospy.exceptions import TransportTerminated
 
 WARN_PERIOD = 5.0  # [s] between repeats of the warning of one publisher
+
+
+class BlockingPublisher(rospy.Publisher):
+    """``rospy.Publisher`` written in the caller's thread, waiting for every reader: nothing is lost."""
+
+    def __init__(self, name, data_class, **kwargs):
+        with warnings.catch_warnings():  # rospy warns of queue_size=None; waiting for the reader is the point
+            warnings.simplefilter("ignore", SyntaxWarning)
+            super().__init__(name, data_class, queue_size=None, **kwargs)
+
+
+def recorded_publisher(lockstep: bool, otherwise=None):
+    """The publisher class of a stream a run records: blocking in lockstep (nothing lost), else
+    ``otherwise`` (NonBlockingPublisher by default)."""
+    return BlockingPublisher if lockstep else (otherwise or NonBlockingPublisher)
 
 
 class NonBlockingPublisher(rospy.Publisher):

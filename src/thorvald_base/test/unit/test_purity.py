@@ -36,6 +36,7 @@ NOT_PURE = {
     "thorvald_base.msg": "aliases of thorvald_msgs for code written for the original",
     "thorvald_base.srv": "aliases of thorvald_msgs for code written for the original",
     "thorvald_bringup.report_bag": "reads a rosbag, whose messages are genpy's",
+    "thorvald_bringup.record_node": "a node: record_drive, a bag recorder that drops nothing",
     "thorvald_base.calibration_cli": "calibrate_odometry reads a rosbag, whose messages are genpy's",
     "thorvald_sim.scene": "the simulator's physics (pybullet)",
     "thorvald_sim.robot": "the simulator's physics (pybullet)",

@@ -95,7 +95,7 @@ from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
 from thorvald_base import conversions
-from thorvald_base.publishing import NonBlockingPublisher
+from thorvald_base.publishing import NonBlockingPublisher, recorded_publisher
 from thorvald_base.rate_grid import RateGrid
 from thorvald_model import ConfigError
 from thorvald_model.datum import load_datum
@@ -136,7 +136,8 @@ class RobotIO:
         ns = namespace.rstrip("/") + "/" if namespace else "/"
         self.namespace = ns
         self.publish_tf = publish_tf
-        self.odom_pub = NonBlockingPublisher(ns + d.odometry_topic, Odometry)
+        # ground truth and the sensors, which a lockstep run records: nothing lost then (the world waits)
+        self.odom_pub = recorded_publisher(node.lockstep)(ns + d.odometry_topic, Odometry)
         self.joint_pub = NonBlockingPublisher(ns + "joint_states", JointState)
         self.drive_pub = NonBlockingPublisher(ns + "drive_states", BaseState)
         self.commands = CommandSlot(len(robot.wheels))  # the latest, to apply in the loop
@@ -145,7 +146,10 @@ class RobotIO:
         self.passive = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
         self.passive_names = [info.name for _, info in robot.passive] + [s.joint for _, s in robot.springs]
         self.sensors = RobotSensors(
-            robot.sensors, namespace or "/", refused_sensors(robot.sensor_blocks, robot.sensor_problems)
+            robot.sensors,
+            namespace or "/",
+            refused_sensors(robot.sensor_blocks, robot.sensor_problems),
+            publisher=recorded_publisher(node.lockstep),
         )
 
     def on_command(self, msg):
