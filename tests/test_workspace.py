@@ -2,7 +2,6 @@
 
 import glob
 import json
-import math
 import os
 import re
 import subprocess
@@ -10,6 +9,7 @@ import subprocess
 import pytest
 import rosbag
 
+from thorvald_bringup.odometry_report import check_complete
 from thorvald_bringup.report_bag import read_recording
 from thorvald_testing import free_port
 
@@ -103,15 +103,16 @@ def test_main_job_records_a_real_bag_of_the_whole_drive_and_writes_figures_8_and
         assert os.path.getsize(png) > 30000 and png in demo, name
 
 
-def test_the_same_seed_in_lockstep_gives_the_same_report_beside_a_busy_core(demo, tmp_path):
+def test_the_same_seed_in_lockstep_gives_the_same_report_with_both_cores_busy(demo, tmp_path):
     """Repeatable runs: the main job's field:3 drive (on whatever machine load the suite had) and the
-    same drive again here, beside a core kept busy, read the same figures and record the same ground
-    truth and odometry. In lockstep the simulator starts paused, verification_drive unpauses it once
-    every node is connected, base_driver follows its stamped commands instant by instant, and every
-    sensor's noise is drawn for its instant: the runs are the same to the bit, the millimetre is the
-    issue's bound."""
+    same drive again here, beside two processes keeping both cores busy, read the same figures and
+    record the same drive states, ground truth and odometry, to the bit, every message of them. In
+    lockstep the simulator starts paused, verification_drive unpauses it once every node is
+    connected, base_driver follows its stamped commands instant by instant, every sensor's noise is
+    drawn for its instant, and what the run records is published waiting for its reader and recorded
+    by record_drive, which drops nothing."""
     first = os.path.join(WS, "build", "odometry_report_field")
-    burner = subprocess.Popen(["python3", "-c", "while True: pass"])
+    burners = [subprocess.Popen(["python3", "-c", "while True: pass"]) for _ in range(2)]
     try:
         proc = run(
             [
@@ -130,32 +131,30 @@ def test_the_same_seed_in_lockstep_gives_the_same_report_beside_a_busy_core(demo
             timeout=600,
         )
     finally:
-        burner.kill()
-        burner.wait()
+        for burner in burners:
+            burner.kill()
+            burner.wait()
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     with open(os.path.join(first, "figures.json")) as f:
         before = json.load(f)
     with open(tmp_path / "figures.json") as f:
         again = json.load(f)
-    assert sorted(before) == sorted(again)
-    for table in ("against_truth", "against_rtk_gnss"):
-        for path, figures in before[table].items():
-            for key, value in figures.items():
-                if value is None:  # the reference's own error
-                    assert again[table][path][key] is None
-                    continue
-                bound = 1e-3 if key.endswith("_m") else 1e-3 * 100 / 80 if key.endswith("percent") else 0.01
-                assert abs(again[table][path][key] - value) <= bound, (table, path, key, value, again[table][path][key])
-    # the recordings themselves: ground truth and odometry at every common instant, within a millimetre
+    assert again == before
+    # the recordings themselves: whole (no message lost), and the same at every instant both hold (the
+    # drive ends the launch, whose shutdown takes its own time: one recording runs on a little longer)
     a = read_recording(os.path.join(first, "odometry_report.bag"))
     b = read_recording(str(tmp_path / "odometry_report.bag"))
+    for recording in (a, b):
+        check_complete(recording)
+    n = min(len(a.states), len(b.states))
+    assert a.states[n - 1][0] > 88.5  # past the manoeuvre's end (3 s of settling, 84 s, 1.5 s of rest)
+    assert a.states[:n] == b.states[:n]  # stamps, steering, speeds
     for name in ("truth", "odometry"):
         pa, pb = getattr(a, name), getattr(b, name)
-        xy_a, xy_b = dict(zip(pa.t, zip(pa.x, pa.y))), dict(zip(pb.t, zip(pb.x, pb.y)))
-        common = sorted(set(xy_a) & set(xy_b))
-        assert len(common) > 4000, name  # 90 s at 50 Hz
-        worst = max(math.hypot(xy_a[t][0] - xy_b[t][0], xy_a[t][1] - xy_b[t][1]) for t in common)
-        assert worst < 1e-3, (name, worst)
+        n = min(len(pa.t), len(pb.t))
+        assert pa.t[n - 1] > 88.5, name
+        for field in ("t", "x", "y", "yaw", "vx", "vy", "wz"):
+            assert getattr(pa, field)[:n] == getattr(pb, field)[:n], (name, field)
 
 
 def test_verification_drive_on_base_drivers_own_simulated_drives():
