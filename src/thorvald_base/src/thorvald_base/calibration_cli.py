@@ -48,6 +48,7 @@ from .calibration import (
     odometry_error,
     set_drive_params_command,
 )
+from .calibration.observable import FAR
 from .conversions import quaternion_yaw
 from .errors import CalibrationError, ThorvaldBaseError
 
@@ -340,6 +341,13 @@ def print_text(outcome: Outcome) -> None:
             print(f"  {c.describe()}")
         if outcome.fit == "odometry":
             print("fitted: the determined combinations; the others kept at the values in effect")
+            far = fit.far()
+            if far:
+                moved = ", ".join(f"{name} {priors:+.0f}" for name, priors in far)
+                print(
+                    f"warning: the fit moved parameters beyond {FAR:g} of their priors ({moved}): the drive's errors "
+                    "are not the odometry model's (slip, wheels fighting each other); prefer --fit drives"
+                )
     print(
         f"odometry against ground truth: before {before.distance_error_percent:+.3f} % of "
         f"{before.truth_distance_m:.2f} m, end point {before.end_point_m:.3f} m; after "

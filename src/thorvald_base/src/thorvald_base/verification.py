@@ -37,6 +37,100 @@ def plan_for(config: RobotConfig) -> Tuple[str, List[Segment]]:
     return "a stadium twice: straights and half circles about its axle line", _stadium(axle)
 
 
+MANOEUVRES = ("verification", "calibration")
+SIDE = 4.0  # [m] of the calibration drive's square (UMBmark's 4 m)
+CORNER = 1.0  # [m] a fixed-axle robot's corner radius on the calibration drive (about a point of its axle line)
+TURN_SHARE = 0.9  # of a wheel's speed limit: a fixed-axle robot's turns are slowed to keep within it
+
+
+def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str, List[Segment]]:
+    """(description, segments) of the manoeuvre ``name`` (MANOEUVRES) for this robot; ValueError for
+    another name or a side that is not a positive length."""
+    if name == "verification":
+        return plan_for(config)
+    if name != "calibration":
+        raise ValueError(f"manoeuvre must be one of {', '.join(MANOEUVRES)}, not {name!r}")
+    if not (side > 0.0 and math.isfinite(side)):
+        raise ValueError(f"side must be a positive length [m], not {side!r}")
+    axle, _ = common_axle(config.drives, config.passive_wheels)
+    if axle is None:
+        return (
+            f"calibration: straight {side:g} m both ways, crab legs both ways, spins both ways, UMBmark "
+            f"squares of {side:g} m both ways, circles both ways",
+            _calibration_omnidirectional(side),
+        )
+    return (
+        f"calibration: straight {side:g} m both ways, UMBmark squares of {side:g} m both ways with rounded "
+        "corners about the axle line, circles both ways",
+        _calibration_axle(axle, side, config.drives),
+    )
+
+
+def _calibration_omnidirectional(side: float) -> List[Segment]:
+    """What a calibration drive must excite on a robot whose every wheel steers: vx alone both ways (the
+    common scale), vy alone both ways (the common offset: crab legs), wz alone both ways (spins: the
+    left-right and front-rear differences), and combined (UMBmark's squares both ways, whose errors
+    in turning and in distance show apart, and circles both ways: translating while turning). Every
+    part ends where it started, so the drive stays within a square of 2 side around the start."""
+    t = side / SPEED
+    spin = SPEED / 1.0  # [rad/s]: a quarter turn in pi/2 s
+    quarter = (math.pi / 2.0) / spin
+    circle = math.pi * side / SPEED  # a circle of diameter side
+    w = 2.0 * math.pi / circle
+    legs = [
+        Segment(Twist(SPEED, 0.0, 0.0), t, f"forward {side:g} m"),
+        Segment(Twist(-SPEED, 0.0, 0.0), t, f"backward {side:g} m"),
+        Segment(Twist(0.0, SPEED, 0.0), t, f"crab left {side:g} m"),
+        Segment(Twist(0.0, -SPEED, 0.0), t, f"crab right {side:g} m"),
+        Segment(Twist(0.0, 0.0, spin), 4.0 * quarter, "spin left, a full turn"),
+        Segment(Twist(0.0, 0.0, -spin), 4.0 * quarter, "spin right, a full turn"),
+    ]
+    for sign, way in ((1.0, "counter-clockwise"), (-1.0, "clockwise")):
+        for corner in range(4):
+            legs.append(Segment(Twist(SPEED, 0.0, 0.0), t, f"square {way}: side {corner + 1}"))
+            legs.append(Segment(Twist(0.0, 0.0, sign * spin), quarter, f"square {way}: corner {corner + 1}"))
+    legs += [
+        Segment(Twist(SPEED, 0.0, w), circle, f"circle left, {side:g} m across"),
+        Segment(Twist(SPEED, 0.0, -w), circle, f"circle right, {side:g} m across"),
+    ]
+    return _with_pauses(legs)
+
+
+def _turn(cx: float, cy: float, sign: float, drives) -> Twist:
+    """The twist turning about (cx, cy) in base_link (sign 1: left), base_link at SPEED, slowed so that
+    no wheel goes faster than TURN_SHARE of its limit."""
+    radius = math.hypot(cx, cy)
+    w = sign * SPEED / radius
+    fastest = max((abs(w) * math.hypot(d.x - cx, d.y - cy) / d.max_wheel_speed for d in drives), default=0.0)
+    w /= max(1.0, fastest / TURN_SHARE)
+    return Twist(w * cy, -w * cx, w)  # v = w z x (origin - centre)
+
+
+def _calibration_axle(axle, side: float, drives) -> List[Segment]:
+    """The same for a robot with a fixed axle, which cannot crab nor always spin: straight both ways
+    along its rolling direction, UMBmark's squares both ways with corners turned about a point of
+    its axle line CORNER to the side, and circles both ways about such points (a turn slowed where
+    its outer wheel would pass TURN_SHARE of its speed limit)."""
+    dx, dy = axle.dx, axle.dy
+    if dy < 0 or (dy == 0 and dx < 0):  # d points to the robot's left
+        dx, dy = -dx, -dy
+    nx, ny = dy, -dx
+    straight, back = Twist(SPEED * nx, SPEED * ny, 0.0), Twist(-SPEED * nx, -SPEED * ny, 0.0)
+    foot = -(axle.x * dx + axle.y * dy)  # from the axle point to the foot of base_link's perpendicular
+    t = side / SPEED
+    legs = [Segment(straight, t, f"straight {side:g} m"), Segment(back, t, f"back {side:g} m")]
+    for sign, way in ((1.0, "counter-clockwise"), (-1.0, "clockwise")):
+        turn = _turn(axle.x + (foot + sign * CORNER) * dx, axle.y + (foot + sign * CORNER) * dy, sign, drives)
+        for corner in range(4):
+            legs.append(Segment(straight, t, f"square {way}: side {corner + 1}"))
+            legs.append(Segment(turn, (math.pi / 2.0) / abs(turn.wz), f"square {way}: corner {corner + 1}"))
+    for sign, way in ((1.0, "left"), (-1.0, "right")):
+        turn = _turn(axle.x + (foot + sign * side / 2.0) * dx, axle.y + (foot + sign * side / 2.0) * dy, sign, drives)
+        legs.append(Segment(turn, 2.0 * math.pi / abs(turn.wz), f"circle {way}, {side:g} m across"))
+    # no pauses, as on the stadium: a fixed-axle robot changes curvature by its wheels' speeds
+    return [*legs, Segment(Twist(), PAUSE, "stop")]
+
+
 def _omnidirectional() -> List[Segment]:
     circle = 20.0  # [s]: a full circle of 20 m at 1 m/s
     w = 2.0 * math.pi / circle

@@ -24,7 +24,10 @@ none), ``~connections`` (more such waits: a list of ``"NODE TOPIC"``, e.g. ``"ba
 drive_states"``: every publisher of TOPIC connected to NODE; default none), ``~unpause`` (the
 service that unpauses a simulator started paused, e.g. ``/simulator/unpause``: the drive waits
 for its connections alone, as nothing moves yet, publishes its first stamped commands and
-unpauses, so the run is the same from its first instant; default none).
+unpauses, so the run is the same from its first instant; default none), ``~manoeuvre``
+(``verification``, the paper's, the default; or ``calibration``: what calibrate_odometry needs,
+:func:`thorvald_base.verification.plan_named`) and ``~side`` [m] (the calibration drive's square,
+default 4).
 """
 
 import math
@@ -44,7 +47,7 @@ from std_srvs.srv import Empty
 from thorvald_model import ConfigError, load_robot_config
 
 from . import conversions
-from .verification import duration, plan_for, report, twist_at
+from .verification import SIDE, duration, plan_named, report, twist_at
 
 CONNECTION_POLL = 0.2  # [s] wall between questions to the publishers of the awaited topics
 
@@ -80,7 +83,8 @@ class VerificationDrive:
         self.ready = not ready_topic
         if ready_topic:
             self.ready_sub = rospy.Subscriber(ready_topic, Odometry, self.on_ready, queue_size=1)
-        self.description, self.plan = plan_for(self.config)
+        manoeuvre = str(rospy.get_param("~manoeuvre", "verification"))
+        self.description, self.plan = plan_named(manoeuvre, self.config, float(rospy.get_param("~side", SIDE)))
         self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10) if self.own_clock else None
         self.cmd_pub = rospy.Publisher("cmd_vel", TwistMsg, queue_size=10)
         self.stamped_pub = rospy.Publisher("cmd_vel_stamped", TwistStamped, queue_size=100)

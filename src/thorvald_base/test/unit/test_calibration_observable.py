@@ -143,3 +143,14 @@ def test_a_drive_that_never_moves_or_of_another_robot_is_refused():
     with pytest.raises(CalibrationError, match="2 drives, the robot 4"):
         observable_fit(config, other, drive.pose_truth)
     assert math.isfinite(observable_fit(config, drive.recording, drive.pose_truth).sigma)
+
+
+def test_a_fit_that_moves_parameters_far_beyond_their_priors_says_so():
+    config = four_ws()
+    drive = synthetic_drive(config, MIXED, RADII, OFFSETS)
+    assert observable_fit(config, drive.recording, drive.pose_truth).far() == []  # within the field's +-1 %
+    # ground truth 20 % slower than the wheels turn (a robot slipping all the way): 20 priors of scale
+    t = drive.pose_truth
+    slipping = type(t)(t.t, t.x, t.y, t.yaw, 0.8 * t.vx, 0.8 * t.vy, t.wz)
+    far = dict(observable_fit(config, drive.recording, slipping).far())
+    assert set(RADIUS) <= set(far) and all(far[n] < -10 for n in RADIUS)

@@ -1,14 +1,20 @@
-"""The verification manoeuvre: about 80 m, ending at the start, realisable by every example robot."""
+"""The verification manoeuvre: about 80 m, ending at the start, realisable by every example robot; and the
+calibration manoeuvre: within its area, realisable, determining all a drive can through the odometry."""
 
 import math
 import os
 
+import numpy as np
 import pytest
-from base_test_helpers import EXAMPLE_ROBOTS
+from base_test_helpers import EXAMPLE_ROBOTS, diff, four_wd_two_ws, four_ws
+from calibration_test_helpers import synthetic_drive
 
+from thorvald_base.calibration import observable_fit
+from thorvald_base.kinematics import Pose, Twist, integrate_se2
 from thorvald_base.plugins import load_calculator
-from thorvald_base.verification import commanded_path, duration, plan_for, report
+from thorvald_base.verification import commanded_path, duration, plan_for, plan_named, report
 from thorvald_model import load_robot_config
+from thorvald_model.layout import common_axle
 
 
 @pytest.mark.parametrize("path", EXAMPLE_ROBOTS, ids=lambda p: os.path.basename(p)[:-5])
@@ -46,3 +52,70 @@ def test_report_compares_command_and_odometry():
     text = report("std", std, description, plan, [(0.0, 0.0), (3.0, 4.0), (0.3, 0.4)], sim_time=80.0, wall=10.0)
     assert "distance by odometry       9.50 m" in text  # 5 m out, hypot(2.7, 3.6) = 4.5 m back
     assert "end-point difference      0.500 m" in text
+
+
+# ---- the calibration manoeuvre ---------------------------------------------------------------------
+def poses(plan, step=0.01):
+    """base_link's poses along the plan, followed exactly."""
+    pose, out = Pose(), []
+    for seg in plan:
+        n = max(1, round(seg.duration / step))
+        for _ in range(n):
+            pose = integrate_se2(pose, seg.twist, seg.duration / n)
+            out.append(pose)
+    return out
+
+
+@pytest.mark.parametrize("path", EXAMPLE_ROBOTS, ids=lambda p: os.path.basename(p)[:-5])
+def test_the_calibration_drive_ends_where_it_started_within_its_area_every_twist_realisable(path):
+    config = load_robot_config(path)
+    calc = load_calculator(config)
+    _, plan = plan_named("calibration", config, side=4.0)
+    track = poses(plan)
+    assert math.hypot(track[-1].x, track[-1].y) < 1e-6 and abs(math.remainder(track[-1].yaw, 2 * math.pi)) < 1e-6
+    assert max(max(abs(p.x), abs(p.y)) for p in track) <= 2 * 4.0 + 1e-6  # a square of twice the side
+    for seg in plan:
+        result = calc.calculate_command(seg.twist)
+        assert not result.changed, (seg.label, result.twist)
+        for cmd, d in zip(result.commands, config.drives):
+            assert abs(cmd.speed) <= d.max_wheel_speed, (seg.label, d.name)
+    # every way of moving it can, both ways: forward and back, turning left and right
+    assert any(s.twist.vx > 0.5 for s in plan) or any(math.hypot(s.twist.vx, s.twist.vy) > 0.5 for s in plan)
+    assert any(s.twist.wz > 0.1 for s in plan) and any(s.twist.wz < -0.1 for s in plan)
+    if common_axle(config.drives, config.passive_wheels)[0] is None:  # every wheel steers
+        assert any(s.twist.vy > 0.5 and s.twist.wz == 0 for s in plan)  # crab legs
+        assert any(s.twist.vy < -0.5 and s.twist.wz == 0 for s in plan)
+        assert any(s.twist.vx == s.twist.vy == 0 and s.twist.wz > 0 for s in plan)  # spins
+        assert any(s.twist.vx == s.twist.vy == 0 and s.twist.wz < 0 for s in plan)
+
+
+@pytest.mark.parametrize("make", [four_ws, diff, four_wd_two_ws], ids=["4ws", "diff", "4wd2ws"])
+def test_the_calibration_drive_determines_every_combination_any_drive_can(make):
+    """What a long drive of random twists (every direction the robot can move in, for minutes)
+    determines through the odometry is the most any drive can; the calibration drive, in under two
+    minutes, determines as much."""
+    config = make()
+    calc = load_calculator(config)
+    _, plan = plan_named("calibration", config)
+    radii = [d.r_wheel * (1 + 0.01 * (-1) ** i) for i, d in enumerate(config.drives)]
+    offsets = [0.005 * (i % 3 - 1) if d.steerable else 0.0 for i, d in enumerate(config.drives)]
+    drive = synthetic_drive(config, [(s.duration, s.twist) for s in plan], radii, offsets)
+    fit = observable_fit(config, drive.recording, drive.pose_truth)
+    rng = np.random.default_rng(0)
+    segments = [(2.0, calc.calculate_command(Twist(*rng.uniform(-0.8, 0.8, 3))).twist) for _ in range(150)]
+    rich = observable_fit(config, *_truthful(synthetic_drive(config, segments, radii, offsets)))
+    assert len(rich.determined) < len(rich.names) or make is diff  # some combinations no drive shows
+    assert len(fit.determined) == len(rich.determined)
+
+
+def _truthful(drive):
+    return drive.recording, drive.pose_truth
+
+
+def test_a_manoeuvre_of_another_name_or_a_bad_side_is_refused():
+    config = four_ws()
+    with pytest.raises(ValueError, match="manoeuvre must be one of verification, calibration, not 'umbmark'"):
+        plan_named("umbmark", config)
+    with pytest.raises(ValueError, match="side must be a positive length"):
+        plan_named("calibration", config, side=0.0)
+    assert plan_named("verification", config) == plan_for(config)

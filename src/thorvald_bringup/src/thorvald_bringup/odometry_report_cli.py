@@ -91,8 +91,9 @@ def robot_file(args) -> str:
     return path
 
 
-def drive(args, model: str, bag: str) -> float:
-    """Runs odometry_report.launch until the drive ends; returns the wall time [s]."""
+def drive(args, model: str, bag: str, manoeuvre: str = "verification", side: float = 4.0) -> float:
+    """Runs odometry_report.launch until the drive ends; returns the wall time [s]. args: world,
+    real_time_factor, gui, as_built, calibration, timeout."""
     port = free_port()
     env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
     log = os.path.join(os.path.dirname(bag), "odometry_report_launch.log")
@@ -109,13 +110,15 @@ def drive(args, model: str, bag: str) -> float:
         f"with_gui:={'true' if args.gui else 'false'}",
         f"as_built:={args.as_built}",
         f"calibration:={os.path.abspath(args.calibration) if args.calibration else ''}",
+        f"manoeuvre:={manoeuvre}",
+        f"side:={side:g}",
     ]
     for stale in (bag, bag + ".active"):
         if os.path.exists(stale):
             os.remove(stale)
     print(
         f"Driving {os.path.basename(model)[:-5]}{' as built ' + args.as_built if args.as_built else ''} through the "
-        f"verification manoeuvre on {args.world} "
+        f"{manoeuvre} manoeuvre on {args.world} "
         f"(simulator, measured drives, ROS master on port {port}; log {log})",
         flush=True,
     )

@@ -40,10 +40,11 @@ class SimMeasuredTest(unittest.TestCase):
         if settle:
             self.nav[robot].send()
             sim_sleep(settle)
-        last = self.truth[robot].get()
-        truth1, odom1 = planar(last), planar(self.odometry[robot].get())
+        last, odom = self.truth[robot].get(), self.odometry[robot].get()
+        truth1, odom1 = planar(last), planar(odom)
         self.nav[robot].send()
         self.elapsed = last.header.stamp.to_sec() - sent  # simulated s from the command to the truth sample
+        self.lag = last.header.stamp.to_sec() - odom.header.stamp.to_sec()  # the odometry sample's age behind it
         return delta(truth0, truth1), delta(odom0, odom1)
 
     def test_odometry_follows_ground_truth_over_10_m_of_tarmac(self):
@@ -75,7 +76,11 @@ class SimMeasuredTest(unittest.TestCase):
         rospy.loginfo("ice: %.3f s of simulated time from the command, at most %.4f m at mu g", t, bound)
         self.assertGreater(odom[0], 0.5)  # it drove
         self.assertLess(truth[0], bound)
-        self.assertGreater(odom[0] - truth[0], 0.05)
+        # at one instant: the odometry sample may be older than the truth sample on a loaded machine
+        # (its delivery came first); its wheels turned at 1 m/s meanwhile (a CI run read 0.031 m apart
+        # uncorrected)
+        rospy.loginfo("ice: odometry sampled %.3f s before ground truth", self.lag)
+        self.assertGreater(odom[0] + 1.0 * self.lag - truth[0], 0.05)
 
 
 if __name__ == "__main__":

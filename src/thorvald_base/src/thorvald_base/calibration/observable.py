@@ -53,6 +53,7 @@ DETERMINED = 0.5  # of the prior's uncertainty: a combination left less uncertai
 NOISE_FLOOR = 1e-6  # [m/s]: sigma's floor, so that a noiseless drive still weighs the prior
 SHOWN = 0.1  # a combination's description names the parameters weighing at least this much in it
 ITERATIONS = 5  # of sigma's estimate and the fit
+FAR = 3.0  # priors: a parameter moved further than this says the drive's errors are not the model's
 
 
 @dataclass(frozen=True)
@@ -95,6 +96,19 @@ class ObservableFit:
         for (index, key, value), before, sd in zip(self.changes(), self.in_effect, self.sd):
             parameters.append(ParameterEstimate(f"drive{index}", index, key, value, sd, before, True))
         return Calibration(SIMULATOR, tuple(parameters), None, self.sigma, self.observations, turned)
+
+    def far(self, priors: float = FAR) -> List[Tuple[str, float]]:
+        """(parameter, how many of its priors it moved) of the parameters the fit moved further than
+        ``priors`` of them: a drive whose errors are not the model's (slip, wheels fighting each other
+        through a turn) is fitted by moving parameters far along the combinations it sees weakly."""
+        out = []
+        for name, value, before in zip(self.names, self.values, self.in_effect):
+            moved = (
+                (value / before - 1.0) / RADIUS_PRIOR if name.endswith("r_wheel") else (value - before) / OFFSET_PRIOR
+            )
+            if abs(moved) > priors:
+                out.append((name, moved))
+        return out
 
     def changes(self) -> List[Tuple[int, str, float]]:
         """(drive index, key, value) of every parameter: set_drive_params' and the calibration file's."""
