@@ -50,6 +50,7 @@ NOT_PURE = {
 CALL_TIME_ROS = {
     "thorvald_sim.can_emulator_node": "the emulator runs without ROS too; with a master it offers services",
     "thorvald_bringup.odometry_report_cli": "a command that reads the recorded bag (genpy) after the drive",
+    "thorvald_bringup.calibration_drive_cli": "a command that calibrates from the recorded bag (genpy) after the drive",
     "thorvald_sim.sensor_kinds.model": "the sensor kinds' models call pybullet; their block readers never load it",
     "thorvald_design.runs": "a study's run (in a worker process) drives its candidate in the simulator",
 }
