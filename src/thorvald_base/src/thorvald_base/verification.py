@@ -37,7 +37,8 @@ def plan_for(config: RobotConfig) -> Tuple[str, List[Segment]]:
     return "a stadium twice: straights and half circles about its axle line", _stadium(axle)
 
 
-MANOEUVRES = ("verification", "calibration")
+MANOEUVRES = ("verification", "calibration", "field")
+ROWS, ROW_LENGTH, ROW_SPACING = 5, 15.0, 1.5  # the field route: every second row of 0.75 m rows
 SIDE = 4.0  # [m] of the calibration drive's square (UMBmark's 4 m)
 CORNER = 1.0  # [m] a fixed-axle robot's corner radius on the calibration drive (about a point of its axle line)
 TURN_SHARE = 0.9  # of a wheel's speed limit: a fixed-axle robot's turns are slowed to keep within it
@@ -48,6 +49,11 @@ def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str,
     another name or a side that is not a positive length."""
     if name == "verification":
         return plan_for(config)
+    if name == "field":
+        return (
+            f"a field route: {ROWS} rows of {ROW_LENGTH:g} m, {ROW_SPACING:g} m apart, joined by headland U turns",
+            _field_route(config),
+        )
     if name != "calibration":
         raise ValueError(f"manoeuvre must be one of {', '.join(MANOEUVRES)}, not {name!r}")
     if not (side > 0.0 and math.isfinite(side)):
@@ -128,6 +134,33 @@ def _calibration_axle(axle, side: float, drives) -> List[Segment]:
         turn = _turn(axle.x + (foot + sign * side / 2.0) * dx, axle.y + (foot + sign * side / 2.0) * dy, sign, drives)
         legs.append(Segment(turn, 2.0 * math.pi / abs(turn.wz), f"circle {way}, {side:g} m across"))
     # no pauses, as on the stadium: a fixed-axle robot changes curvature by its wheels' speeds
+    return [*legs, Segment(Twist(), PAUSE, "stop")]
+
+
+def _field_route(config: RobotConfig) -> List[Segment]:
+    """A drive unlike the calibration drive, about the paper's length: rows along the robot's rolling
+    direction joined by half circles at the headland, alternately left and right, as a robot working
+    every second row of a field drives them (a robot whose every wheel steers turns about a point
+    half the spacing to the side; a fixed-axle robot about such a point of its axle line, slowed as
+    its calibration drive's turns are)."""
+    axle, _ = common_axle(config.drives, config.passive_wheels)
+    if axle is None:
+        dx, dy, ax, ay = 0.0, 1.0, 0.0, 0.0  # turn about (0, +-spacing/2), straight along +x
+    else:
+        dx, dy, ax, ay = axle.dx, axle.dy, axle.x, axle.y
+        if dy < 0 or (dy == 0 and dx < 0):
+            dx, dy = -dx, -dy
+    nx, ny = dy, -dx
+    foot = -(ax * dx + ay * dy)
+    straight = Twist(SPEED * nx, SPEED * ny, 0.0)
+    legs = []
+    for row in range(ROWS):
+        legs.append(Segment(straight, ROW_LENGTH / SPEED, f"row {row + 1}, {ROW_LENGTH:g} m"))
+        if row < ROWS - 1:
+            sign = 1.0 if row % 2 == 0 else -1.0
+            offset = foot + sign * ROW_SPACING / 2.0
+            turn = _turn(ax + offset * dx, ay + offset * dy, sign, config.drives)
+            legs.append(Segment(turn, math.pi / abs(turn.wz), f"headland U turn {'left' if sign > 0 else 'right'}"))
     return [*legs, Segment(Twist(), PAUSE, "stop")]
 
 

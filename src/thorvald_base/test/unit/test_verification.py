@@ -114,8 +114,28 @@ def _truthful(drive):
 
 def test_a_manoeuvre_of_another_name_or_a_bad_side_is_refused():
     config = four_ws()
-    with pytest.raises(ValueError, match="manoeuvre must be one of verification, calibration, not 'umbmark'"):
+    with pytest.raises(ValueError, match="manoeuvre must be one of verification, calibration, field, not 'umbmark'"):
         plan_named("umbmark", config)
     with pytest.raises(ValueError, match="side must be a positive length"):
         plan_named("calibration", config, side=0.0)
     assert plan_named("verification", config) == plan_for(config)
+
+
+@pytest.mark.parametrize("path", EXAMPLE_ROBOTS, ids=lambda p: os.path.basename(p)[:-5])
+def test_the_field_route_is_rows_and_headland_turns_of_about_the_papers_length(path):
+    config = load_robot_config(path)
+    calc = load_calculator(config)
+    _, plan = plan_named("field", config)
+    end, dist = commanded_path(plan)
+    assert 80.0 < dist < 90.0  # the paper's 80 m
+    # five rows along the robot's rolling direction, every second row of 0.75 m rows: it ends at the far
+    # end of the fifth row, 4 x 1.5 m across, heading the way it started
+    rows = [s for s in plan if s.label.startswith("row")]
+    assert len(rows) == 5 and len([s for s in plan if "U turn" in s.label]) == 4
+    assert math.hypot(end.x, end.y) == pytest.approx(math.hypot(15.0, 6.0), abs=1e-6)
+    assert abs(math.remainder(end.yaw, 2 * math.pi)) < 1e-6
+    for seg in plan:
+        result = calc.calculate_command(seg.twist)
+        assert not result.changed, (seg.label, result.twist)
+        for cmd, d in zip(result.commands, config.drives):
+            assert abs(cmd.speed) <= d.max_wheel_speed, (seg.label, d.name)

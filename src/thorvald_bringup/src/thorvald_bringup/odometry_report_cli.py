@@ -49,8 +49,15 @@ def parser() -> argparse.ArgumentParser:
     )
     robot.add_argument("--robot-model", metavar="FILE", help="a robot configuration file instead of an example robot")
     p.add_argument("--bag", metavar="FILE", help="report from this bag instead of driving")
-    p.add_argument("--plan", action="store_true", help="with --bag: the bag is of the verification manoeuvre")
+    p.add_argument("--plan", action="store_true", help="with --bag: the bag is of --manoeuvre's plan")
     p.add_argument("--world", default="tarmac_gravel", help="the simulator's world (default tarmac_gravel)")
+    p.add_argument(
+        "--manoeuvre",
+        choices=("verification", "field", "calibration"),
+        default="verification",
+        help="the paper's verification manoeuvre (default), a field route of rows and headland turns (a drive "
+        "unlike the calibration drive, to validate a calibration on), or the calibration drive",
+    )
     p.add_argument(
         "--as-built",
         metavar="FILE|PROFILE:SEED",
@@ -199,10 +206,10 @@ def run(args) -> int:
         if shutil.which("roslaunch") is None:
             raise DriveError("roslaunch not found: source the workspace's devel/setup.bash")
         bag = os.path.join(out, "odometry_report.bag")
-        wall = drive(args, model, bag)
+        wall = drive(args, model, bag, args.manoeuvre)
     # ROS's Python (rosbag, the calculators' plugin loader) only now: --help and bad robots stay fast
     from thorvald_base.plugins import load_calculator  # noqa: PLC0415
-    from thorvald_base.verification import commanded_path, plan_for  # noqa: PLC0415
+    from thorvald_base.verification import commanded_path, plan_named  # noqa: PLC0415
 
     from .odometry_report import PAPER_SEED, check_complete, format_report, make_report  # noqa: PLC0415
     from .report_bag import read_recording  # noqa: PLC0415
@@ -219,7 +226,7 @@ def run(args) -> int:
     calculators = {e: load_calculator(config, estimator=e, seed=PAPER_SEED) for e in ("lsq", "paper")}
     report = make_report(recording, calculators)
     if wall is not None or args.plan:
-        report.planned_distance = commanded_path(plan_for(config)[1])[1]
+        report.planned_distance = commanded_path(plan_named(args.manoeuvre, config)[1])[1]
     print()
     print(format_report(report, (TARGET_DISTANCE_ERROR, TARGET_END_POINT)))
     if args.as_built:
