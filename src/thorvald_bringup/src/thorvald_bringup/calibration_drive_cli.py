@@ -22,6 +22,7 @@ import os
 import sys
 import textwrap
 
+from thorvald_base.verification import SIDE
 from thorvald_model import ConfigError, load_robot_config
 from thorvald_sim.as_built import PROFILES, as_built_for
 
@@ -29,7 +30,6 @@ from .errors import DriveError, ThorvaldBringupError
 from .odometry_report_cli import drive, robot_file
 
 BAG = "calibration_drive.bag"
-SIDE = 4.0  # [m], UMBmark's square (thorvald_base.verification.SIDE)
 
 
 def parser() -> argparse.ArgumentParser:

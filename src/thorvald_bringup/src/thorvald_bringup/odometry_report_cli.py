@@ -25,6 +25,7 @@ import sys
 import textwrap
 import time
 
+from thorvald_base.verification import MANOEUVRES, SIDE
 from thorvald_model import ConfigError, load_robot_config
 from thorvald_model.ports import free_port
 from thorvald_sim.as_built import PROFILES, as_built_for, describe_as_built
@@ -53,7 +54,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--world", default="tarmac_gravel", help="the simulator's world (default tarmac_gravel)")
     p.add_argument(
         "--manoeuvre",
-        choices=("verification", "field", "calibration"),
+        choices=MANOEUVRES,
         default="verification",
         help="the paper's verification manoeuvre (default), a field route of rows and headland turns (a drive "
         "unlike the calibration drive, to validate a calibration on), or the calibration drive",
@@ -98,7 +99,7 @@ def robot_file(args) -> str:
     return path
 
 
-def drive(args, model: str, bag: str, manoeuvre: str = "verification", side: float = 4.0) -> float:
+def drive(args, model: str, bag: str, manoeuvre: str = "verification", side: float = SIDE) -> float:
     """Runs odometry_report.launch until the drive ends; returns the wall time [s]. args: world,
     real_time_factor, gui, as_built, calibration, timeout."""
     port = free_port()

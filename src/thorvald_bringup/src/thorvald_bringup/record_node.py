@@ -39,7 +39,6 @@ class Recorder:
         self.bag = rosbag.Bag(self.active, "w")
         self.lock = threading.Lock()
         self.classes = {}  # message type -> its class, for the bag's connection records
-        self.count = 0
         self.subscribers = [
             rospy.Subscriber(topic, rospy.AnyMsg, self.on_message, rospy.resolve_name(topic), queue_size=None)
             for topic in topics
@@ -63,7 +62,6 @@ class Recorder:
                 topic, (kind, msg._buff, header["md5sum"], self.classes[kind]), rospy.Time.now(), raw=True,
                 connection_header=connection,
             )  # fmt: skip
-            self.count += 1
 
     def close(self) -> None:
         with self.lock:
