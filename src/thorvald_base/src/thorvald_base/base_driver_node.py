@@ -68,7 +68,7 @@ from sensor_msgs.msg import BatteryState, JointState
 from std_srvs.srv import SetBool, SetBoolResponse, Trigger, TriggerResponse
 
 from thorvald_model import ConfigError, load_robot_config, parse_robot_config
-from thorvald_msgs.msg import BaseState, BatteryArray, CANFrame, ControllerArray, IOArray
+from thorvald_msgs.msg import BaseState, BatteryArray, CANFrame, ControllerArray, DriveCurrents, IOArray
 from thorvald_msgs.srv import (
     CanID,
     CanIDResponse,
@@ -112,13 +112,16 @@ def load_config(raw: dict, params: DriverParams, names: Names = None):
 
 
 class RosDriveTopics(DriveTopics):
-    """A handle's drive commands and measured states on the node's topics (thorvald_msgs/BaseState)."""
+    """A handle's drive commands and measured states on the node's topics (thorvald_msgs/BaseState),
+    and the measured motor currents (thorvald_msgs/DriveCurrents)."""
 
-    def __init__(self, command_topic: str, state_topic: str):
+    def __init__(self, command_topic: str, state_topic: str, current_topic: str):
         self.pub = rospy.Publisher(command_topic, BaseState, queue_size=1)
         self.state_topic = state_topic
+        self.current_topic = current_topic
         self.throttle = Throttle()
         self.sub = None
+        self.current_sub = None
 
     def send(self, commands, time, drives):
         self.pub.publish(
@@ -136,8 +139,17 @@ class RosDriveTopics(DriveTopics):
 
         self.sub = rospy.Subscriber(self.state_topic, BaseState, on_message, queue_size=1)
 
+    def listen_currents(self, on_currents):
+        def on_message(msg):
+            try:
+                on_currents(*conversions.drive_currents(msg), msg.header.stamp.to_sec())
+            except ValueError as e:
+                self.throttle.warn("base_driver: %s ignored: %s", self.current_topic, e)
+
+        self.current_sub = rospy.Subscriber(self.current_topic, DriveCurrents, on_message, queue_size=1)
+
     def close(self):
-        for endpoint in (self.pub, self.sub):
+        for endpoint in (self.pub, self.sub, self.current_sub):
             if endpoint is not None:
                 endpoint.unregister()
 
@@ -146,8 +158,9 @@ class RosPorts(Ports):
     def __init__(self, names: Names):
         self.names = names
 
-    def drive_topics(self, command_topic, state_topic):
-        return RosDriveTopics(self.names.topic(command_topic), self.names.topic(state_topic))
+    def drive_topics(self, command_topic, state_topic, current_topic="drive_currents"):
+        names = self.names
+        return RosDriveTopics(names.topic(command_topic), names.topic(state_topic), names.topic(current_topic))
 
 
 class BaseDriverNode:

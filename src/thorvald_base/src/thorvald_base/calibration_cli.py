@@ -21,7 +21,7 @@ import json
 import math
 import os
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Dict, List, Optional, Tuple
 
 import numpy as np
@@ -48,7 +48,7 @@ from .calibration import (
     odometry_error,
     set_drive_params_command,
 )
-from .calibration.observable import FAR
+from .calibration.observable import FAR, along_undetermined
 from .conversions import quaternion_yaw
 from .errors import CalibrationError, ThorvaldBaseError
 
@@ -171,6 +171,14 @@ def parse_args(argv: Optional[List[str]]):
         "the combinations the drive determines through the odometry, the rest kept at the values in effect "
         "(the simulator's ground truth)",
     )
+    parser.add_argument(
+        "--balance",
+        metavar="FILE",
+        default="",
+        help="balance_wheels' calibration file (each tyre's radius against the others', from the motors' "
+        "currents): the radii move to it along the combinations the drive does not determine (the simulator's "
+        "ground truth), or take it with ground truth's common factor (GNSS)",
+    )
     parser.add_argument("--json", action="store_true", help="print the results as one JSON document")
     return parser.parse_args(argv)
 
@@ -204,6 +212,8 @@ def run(args) -> int:
     else:
         calibration = calibrate(in_effect, recording, truth, window=args.window)
         observable = observable_fit(in_effect, recording, truth) if isinstance(truth, PoseTruth) else None
+    if args.balance:
+        calibration = with_balance(calibration, observable, load_calibration(args.balance, robot), robot)
     calibrated = calibration.calibrated(in_effect)
     bias = calibration.heading_bias[0] if calibration.heading_bias else 0.0
     before = odometry_error(in_effect, recording, truth, bias)
@@ -226,6 +236,29 @@ def run(args) -> int:
     else:
         print_text(outcome)
     return 0
+
+
+def with_balance(calibration: Calibration, observable: Optional[ObservableFit], balanced, robot) -> Calibration:
+    """The calibration with each drive's radius from the balanced calibration file's changes: along the
+    combinations the drive did not determine (with the simulator's ground truth: observable given), or
+    the balanced radii scaled to the calibration's geometric mean (GNSS)."""
+    config = robot
+    for index, key, value in balanced:
+        config = config.with_drive_param(index, key, value)
+    radii = [d.r_wheel for d in config.drives]
+    by_name = {f"{p.drive}.{p.key}": p for p in calibration.parameters}
+    if observable is not None:
+        values = along_undetermined(observable, [by_name[n].value for n in observable.names], radii)
+        moved = dict(zip(observable.names, values))
+    else:
+        fitted = [by_name[f"drive{k}.r_wheel"].value for k in range(len(radii))]
+        scale = math.exp(float(np.mean(np.log(fitted)) - np.mean(np.log(radii))))
+        moved = {f"drive{k}.r_wheel": r * scale for k, r in enumerate(radii)}
+    parameters = []
+    for p in calibration.parameters:
+        value = moved.get(f"{p.drive}.{p.key}", p.value)
+        parameters.append(p if value == p.value else replace(p, value=value, excited=True, reason=""))
+    return replace(calibration, parameters=tuple(parameters))
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,5 @@
-"""Messages from and to the core's values: BaseState, JointState, Odometry, batteries, controllers.
+"""Messages from and to the core's values: BaseState, DriveCurrents, JointState, Odometry, batteries,
+controllers.
 
 The one place where base_driver's values become ROS messages, shared by base_driver, the simulator
 (which follows ``base_state``) and the CAN base. Message types only: no rospy, so it is tested
@@ -6,7 +7,7 @@ without a master. Stamps are ``rospy.Time``/``genpy.Time`` values the caller pas
 """
 
 import math
-from typing import Dict, List, Sequence
+from typing import Dict, List, Sequence, Tuple
 
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Quaternion, TransformStamped, Twist, TwistStamped
@@ -21,6 +22,7 @@ from thorvald_msgs.msg import (
     CANFrame,
     Controller,
     ControllerArray,
+    DriveCurrents,
     IOArray,
     IOData,
     MotorVars,
@@ -95,6 +97,21 @@ def measured_drives(msg: BaseState) -> List[MeasuredDrive]:
     return [
         MeasuredDrive(a, v, p, w) for a, v, p, w in zip(msg.steer_pos, msg.prop_speed, msg.prop_pos, msg.steer_speed)
     ]
+
+
+def currents_msg(stamp, prop_amps: Sequence[float], steer_amps: Sequence[float]) -> DriveCurrents:
+    """Each drive's motor currents [A], in drive order (drive_currents)."""
+    msg = DriveCurrents(prop_amps=list(prop_amps), steer_amps=list(steer_amps))
+    msg.header.stamp = stamp
+    return msg
+
+
+def drive_currents(msg: DriveCurrents) -> Tuple[List[float], List[float]]:
+    """(propulsion, steering) motor currents [A] per drive a DriveCurrents carries."""
+    n, m = len(msg.prop_amps), len(msg.steer_amps)
+    if n != m:
+        raise ValueError(f"DriveCurrents arrays differ in length: prop_amps, steer_amps = {n}, {m}")
+    return list(msg.prop_amps), list(msg.steer_amps)
 
 
 def joint_state_msg(stamp, names: Sequence[str], positions: Sequence[float], velocities: Sequence[float]) -> JointState:

@@ -37,11 +37,18 @@ def plan_for(config: RobotConfig) -> Tuple[str, List[Segment]]:
     return "a stadium twice: straights and half circles about its axle line", _stadium(axle)
 
 
-MANOEUVRES = ("verification", "calibration", "field")
+MANOEUVRES = ("verification", "calibration", "field", "balance")
 ROWS, ROW_LENGTH, ROW_SPACING = 5, 15.0, 1.5  # the field route: every second row of 0.75 m rows
 SIDE = 4.0  # [m] of the calibration drive's square (UMBmark's 4 m)
 CORNER = 1.0  # [m] a fixed-axle robot's corner radius on the calibration drive (about a point of its axle line)
 TURN_SHARE = 0.9  # of a wheel's speed limit: a fixed-axle robot's turns are slowed to keep within it
+# the balancing drive (balance_wheels): straight legs back and forth, slowly (no wheel slides while the
+# radii are still off), each measured after it settled, with a pause after it to change the radii in
+BALANCE_SPEED = 0.2  # [m/s]
+BALANCE_LEGS = 8
+BALANCE_SETTLE = 3.0  # [s] from a leg's start: the robot at speed and the fight steady
+BALANCE_PAUSE = 3.0  # [s]
+BALANCE_LEG = "balance leg"  # the label every leg starts with
 
 
 def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str, List[Segment]]:
@@ -54,10 +61,16 @@ def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str,
             f"a field route: {ROWS} rows of {ROW_LENGTH:g} m, {ROW_SPACING:g} m apart, joined by headland U turns",
             _field_route(config),
         )
-    if name != "calibration":
+    if name not in ("calibration", "balance"):
         raise ValueError(f"manoeuvre must be one of {', '.join(MANOEUVRES)}, not {name!r}")
     if not (side > 0.0 and math.isfinite(side)):
         raise ValueError(f"side must be a positive length [m], not {side!r}")
+    if name == "balance":
+        return (
+            f"balancing the wheels: {BALANCE_LEGS} straight legs of {side:g} m back and forth at "
+            f"{BALANCE_SPEED:g} m/s, the radii changed between them",
+            _balance(config, side),
+        )
     axle, _ = common_axle(config.drives, config.passive_wheels)
     if axle is None:
         return (
@@ -135,6 +148,45 @@ def _calibration_axle(axle, side: float, drives) -> List[Segment]:
         legs.append(Segment(turn, 2.0 * math.pi / abs(turn.wz), f"circle {way}, {side:g} m across"))
     # no pauses, as on the stadium: a fixed-axle robot changes curvature by its wheels' speeds
     return [*legs, Segment(Twist(), PAUSE, "stop")]
+
+
+def _rolling_direction(config: RobotConfig) -> Tuple[float, float]:
+    """The unit direction in base_link along which every wheel rolls without steering: +x, or across a
+    fixed axle (towards +x or, for an axle along x, towards -y)."""
+    axle, _ = common_axle(config.drives, config.passive_wheels)
+    if axle is None:
+        return 1.0, 0.0
+    dx, dy = axle.dx, axle.dy
+    if dy < 0 or (dy == 0 and dx < 0):
+        dx, dy = -dx, -dy
+    return dy, -dx
+
+
+def _balance(config: RobotConfig, side: float) -> List[Segment]:
+    """Straight legs of side [m] along the rolling direction, alternately forwards and back, each
+    followed by a pause (balance_wheels changes the radii there): the drive stays on one line of
+    side."""
+    nx, ny = _rolling_direction(config)
+    legs = []
+    for k in range(BALANCE_LEGS):
+        sign = 1.0 if k % 2 == 0 else -1.0
+        twist = Twist(sign * BALANCE_SPEED * nx, sign * BALANCE_SPEED * ny, 0.0)
+        way = "forwards" if sign > 0 else "back"
+        legs.append(Segment(twist, side / BALANCE_SPEED, f"{BALANCE_LEG} {k + 1}, {side:g} m {way}"))
+        legs.append(Segment(Twist(), BALANCE_PAUSE, "pause: the radii for the next leg"))
+    return legs
+
+
+def balance_legs(plan: Sequence[Segment]) -> List[Tuple[float, float, float]]:
+    """(start, end [s] from the plan's start, rim speed [m/s] signed) of each balancing leg's measured
+    part: from BALANCE_SETTLE after its start to its end."""
+    out, t = [], 0.0
+    for seg in plan:
+        if seg.label.startswith(BALANCE_LEG):  # forwards first, then back, and so on
+            speed = math.hypot(seg.twist.vx, seg.twist.vy) * (1.0 if len(out) % 2 == 0 else -1.0)
+            out.append((t + BALANCE_SETTLE, t + seg.duration, speed))
+        t += seg.duration
+    return out
 
 
 def _field_route(config: RobotConfig) -> List[Segment]:

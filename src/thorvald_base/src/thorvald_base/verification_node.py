@@ -35,6 +35,7 @@ import os
 import sys
 import time
 import xmlrpc.client
+from typing import Optional
 
 import rosgraph
 import rospy
@@ -53,7 +54,8 @@ CONNECTION_POLL = 0.2  # [s] wall between questions to the publishers of the awa
 
 
 class VerificationDrive:
-    def __init__(self):
+    def __init__(self, manoeuvre: Optional[str] = None):
+        """manoeuvre: the plan's name (thorvald_base.verification.MANOEUVRES); None: ``~manoeuvre``."""
         path = rospy.get_param("~robot_model")
         self.config = load_robot_config(path)
         self.name = os.path.splitext(os.path.basename(path))[0]
@@ -83,7 +85,8 @@ class VerificationDrive:
         self.ready = not ready_topic
         if ready_topic:
             self.ready_sub = rospy.Subscriber(ready_topic, Odometry, self.on_ready, queue_size=1)
-        manoeuvre = str(rospy.get_param("~manoeuvre", "verification"))
+        if manoeuvre is None:
+            manoeuvre = str(rospy.get_param("~manoeuvre", "verification"))
         self.description, self.plan = plan_named(manoeuvre, self.config, float(rospy.get_param("~side", SIDE)))
         self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10) if self.own_clock else None
         self.cmd_pub = rospy.Publisher("cmd_vel", TwistMsg, queue_size=10)
@@ -184,6 +187,7 @@ class VerificationDrive:
                 plain = k
                 self.cmd_pub.publish(conversions.twist_msg(self.twist_for(k * period - start)))
             self.tick()
+            self.during(start, self.sim_time - start)
         self.recording = False
         points = [(x, y) for t, x, y in self.points if start - 1e-6 <= t <= stop + 1e-6]
         return report(
@@ -195,6 +199,10 @@ class VerificationDrive:
             sim_time=total,
             wall=time.time() - (start_wall or time.time()),
         )
+
+    def during(self, start: float, t: float) -> None:
+        """Called after each step of simulated time, t [s] from the plan's start at start [s] of ROS
+        time (negative before it): what a drive that acts on the robot between its legs does."""
 
     def publish_ahead(self, index: int, start: float) -> int:
         """Publishes the stamped commands from the one of index (its instant index x the command

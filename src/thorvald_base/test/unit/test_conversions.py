@@ -70,6 +70,15 @@ def test_base_state_round_trip():
         conversions.measured_drives(msg)
 
 
+def test_drive_currents_round_trip():
+    msg = conversions.currents_msg(STAMP, [1.5, -0.6, 0.0], [0.4, 0.0, -2.0])
+    assert msg.header.stamp == STAMP
+    assert conversions.drive_currents(msg) == ([1.5, -0.6, 0.0], [0.4, 0.0, -2.0])
+    msg.steer_amps = msg.steer_amps[:2]
+    with pytest.raises(ValueError, match="prop_amps, steer_amps = 3, 2"):
+        conversions.drive_currents(msg)
+
+
 def test_joint_states_give_wheel_angular_speed():
     config = robot("thorvald_ii_4wd4ws_std")
     names = conversions.joint_names(config.drives, "robot_1/")

@@ -4,7 +4,7 @@ import dataclasses
 import math
 
 import pytest
-from base_test_helpers import four_ws
+from base_test_helpers import diff, four_ws
 
 from thorvald_base.bases import BaseHandle, MeasuredDrive, create_base_handle
 from thorvald_base.bases.handle import DriveTopics, Ports
@@ -113,13 +113,16 @@ class LoopbackTopics(DriveTopics):
     """The node's side of simulated_joints, played in the test: what was sent, and the listener."""
 
     def __init__(self):
-        self.sent, self.listener, self.closed = [], None, False
+        self.sent, self.listener, self.current_listener, self.closed = [], None, None, False
 
     def send(self, commands, time, drives):
         self.sent.append((time, tuple(commands), [d.max_steering_speed for d in drives]))
 
     def listen(self, on_states):
         self.listener = on_states
+
+    def listen_currents(self, on_currents):
+        self.current_listener = on_currents
 
     def close(self):
         self.closed = True
@@ -129,9 +132,9 @@ class LoopbackPorts(Ports):
     def __init__(self):
         self.topics = {}
 
-    def drive_topics(self, command_topic, state_topic):
-        self.topics[(command_topic, state_topic)] = LoopbackTopics()
-        return self.topics[(command_topic, state_topic)]
+    def drive_topics(self, command_topic, state_topic, current_topic="drive_currents"):
+        self.topics[(command_topic, state_topic, current_topic)] = LoopbackTopics()
+        return self.topics[(command_topic, state_topic, current_topic)]
 
 
 def test_simulated_joints_trades_on_the_nodes_drive_topics():
@@ -140,7 +143,7 @@ def test_simulated_joints_trades_on_the_nodes_drive_topics():
     params = DriverParams.from_dict({"base_handle": "simulated_joints", "measured_timeout": 0.25})
     base = create_base_handle(four_ws(), params, ports)
     (topics,) = ports.topics.values()
-    assert list(ports.topics) == [("drive_commands", "drive_states")]
+    assert list(ports.topics) == [("drive_commands", "drive_states", "drive_currents")]
     assert base.stale_after == 0.25
     topics.listener([MeasuredDrive(0.2, 0.3, 1.0, 0.0)] * 4, 5.0)
     base.send_drive_commands([DriveCommand(0.2, 0.4)] * 4, 5.1)
@@ -150,6 +153,53 @@ def test_simulated_joints_trades_on_the_nodes_drive_topics():
     assert topics.closed
     with pytest.raises(ParameterError, match="needs base_driver's topics"):
         create_base_handle(four_ws(), params)
+
+
+def test_simulated_joints_reports_the_simulators_motor_currents():
+    """motor_controller_data of measured drives: per controller the propulsion and steering channels
+    with the measured speeds and angles, the motor currents as they came, and the torque they carry
+    over the drive's limit as relative power (the thorvald_model.motors model)."""
+    ports = LoopbackPorts()
+    base = create_base_handle(four_ws(), DriverParams.from_dict({"base_handle": "simulated_joints"}), ports)
+    (topics,) = ports.topics.values()
+    states = [MeasuredDrive(0.1, 0.5, 2.0, 0.3)] * 4  # steering [rad], rim speed [m/s], wheel angle [rad], [rad/s]
+    topics.listener(states, 1.0)
+    before = base.controllers(1.0)
+    assert [c.name for c in before] == ["drive0", "drive1", "drive2", "drive3"]
+    assert before[0].motor_vars == (("propulsion", 0.5, 2.0, 0.0, 0.0), ("steering", 0.3, 0.1, 0.0, 0.0))
+    topics.current_listener([2.0, -0.84, 0.6, 30.0], [0.5, 0.0, -0.4, 0.0], 1.0)
+    topics.current_listener([9.0] * 4, [9.0] * 4, 1.0125)  # the next instant's: not yet at 1.0
+    prop = [c.motor_vars[0] for c in base.controllers(1.0)]
+    # k_t 0.14 N m/A, i_0 0.6 A, G 42, eta 0.9, limit 1.6 x 42 = 67.2 N m; the wheel turns forward:
+    # 2.0 A: tau_m = 0.14 (2.0 - 0.6) = 0.196 N m motoring, 0.196 x 42 x 0.9 = 7.4088 N m
+    # -0.84 A: tau_m = 0.14 (-1.44) = -0.2016 N m braking, -0.2016 x 42 / 0.9 = -9.408 N m
+    # 0.6 A: the friction alone, 0 N m; 30 A: 155.6 N m, beyond the limit
+    assert [v[3] for v in prop] == [2.0, -0.84, 0.6, 30.0]
+    assert [v[4] for v in prop] == pytest.approx([7.4088 / 67.2, -9.408 / 67.2, 0.0, 1.0])
+    assert all(v[:3] == ("propulsion", 0.5, 2.0) for v in prop)
+    steer = base.controllers(1.0)[0].motor_vars[1]
+    # 0.5 A turning left at 0.3 rad/s: tau_m = 0.14 (0.5 - 0.4) = 0.014 N m, x 42.857 x 0.85 over 1.0 x 42.857
+    assert steer[:4] == ("steering", 0.3, 0.1, 0.5) and steer[4] == pytest.approx(0.014 * 0.85)
+    assert base.controllers(1.0125)[0].motor_vars[0][3] == 9.0
+    # a wheel's radius changed by set_drive_params scales its rim speed, not its current
+    base.set_params(base.config.with_drive_param(0, "r_wheel", 0.2 * 1.002))
+    assert base.controllers(1.0125)[0].motor_vars[0][1:4] == (pytest.approx(0.5 * 1.002), 2.0, 9.0)
+    with pytest.raises(ValueError, match="3 propulsion and 4 steering currents for 4 drives"):
+        base.update_currents([1.0] * 3, [0.0] * 4, 1.05)
+
+
+def test_a_type_1_pair_reports_two_propulsion_channels_on_its_controller():
+    ports = LoopbackPorts()
+    base = create_base_handle(diff(), DriverParams.from_dict({"base_handle": "simulated_joints"}), ports)
+    (topics,) = ports.topics.values()
+    topics.listener([MeasuredDrive(0.0, 0.4, 1.0, 0.0), MeasuredDrive(0.0, -0.4, -1.0, 0.0)], 2.0)
+    topics.current_listener([3.0, -3.0], [0.0, 0.0], 2.0)
+    (controller,) = base.controllers(2.0)
+    assert [v[:4] for v in controller.motor_vars] == [("propulsion", 0.4, 1.0, 3.0), ("propulsion", -0.4, -1.0, -3.0)]
+    # both motoring, each its own way: the same relative power with opposite signs
+    assert (
+        controller.motor_vars[0][4] == pytest.approx(-controller.motor_vars[1][4]) and controller.motor_vars[0][4] > 0
+    )
 
 
 @pytest.mark.parametrize(

@@ -24,6 +24,7 @@ NOT_PURE = {
     "thorvald_base.state_publisher": "fleet_driver's /tf publisher",
     "thorvald_base.node_names": "where a node's names are (rospy's resolution)",
     "thorvald_base.verification_node": "a node",
+    "thorvald_base.balance_node": "a node",
     "thorvald_model.place_robot": "a node",
     "thorvald_sim.simulator_node": "a node",
     "thorvald_sim.spawn_robot": "a node",

@@ -12,7 +12,17 @@ from calibration_test_helpers import synthetic_drive
 from thorvald_base.calibration import observable_fit
 from thorvald_base.kinematics import Pose, Twist, integrate_se2
 from thorvald_base.plugins import load_calculator
-from thorvald_base.verification import commanded_path, duration, plan_for, plan_named, report
+from thorvald_base.verification import (
+    BALANCE_LEGS,
+    BALANCE_SPEED,
+    balance_legs,
+    commanded_path,
+    duration,
+    plan_for,
+    plan_named,
+    report,
+    twist_at,
+)
 from thorvald_model import load_robot_config
 from thorvald_model.layout import common_axle
 
@@ -114,7 +124,7 @@ def _truthful(drive):
 
 def test_a_manoeuvre_of_another_name_or_a_bad_side_is_refused():
     config = four_ws()
-    with pytest.raises(ValueError, match="manoeuvre must be one of verification, calibration, field, not 'umbmark'"):
+    with pytest.raises(ValueError, match="must be one of verification, calibration, field, balance, not 'umbmark'"):
         plan_named("umbmark", config)
     with pytest.raises(ValueError, match="side must be a positive length"):
         plan_named("calibration", config, side=0.0)
@@ -139,3 +149,27 @@ def test_the_field_route_is_rows_and_headland_turns_of_about_the_papers_length(p
         assert not result.changed, (seg.label, result.twist)
         for cmd, d in zip(result.commands, config.drives):
             assert abs(cmd.speed) <= d.max_wheel_speed, (seg.label, d.name)
+
+
+@pytest.mark.parametrize("path", EXAMPLE_ROBOTS, ids=lambda p: os.path.basename(p)[:-5])
+def test_the_balancing_drive_is_straight_legs_both_ways_every_wheel_straight_at_one_speed(path):
+    config = load_robot_config(path)
+    calc = load_calculator(config)
+    _, plan = plan_named("balance", config, side=3.0)
+    track = poses(plan)
+    assert math.hypot(track[-1].x, track[-1].y) < 1e-6  # back where it started, on one line of the side
+    assert max(math.hypot(p.x, p.y) for p in track) <= 3.0 + 1e-6
+    windows = balance_legs(plan)
+    assert len(windows) == BALANCE_LEGS
+    assert [math.copysign(1, speed) for _, _, speed in windows] == [1, -1] * (BALANCE_LEGS // 2)
+    for begin, end, speed in windows:
+        assert abs(abs(speed) - BALANCE_SPEED) < 1e-12 and end - begin == pytest.approx(3.0 / BALANCE_SPEED - 3.0)
+        twist = twist_at(plan, (begin + end) / 2)
+        result = calc.calculate_command(twist)
+        assert not result.changed
+        for cmd in result.commands:  # every wheel rolls straight at the leg's rim speed, the same for all
+            assert abs(math.remainder(cmd.steering, math.pi)) < 1e-9
+            assert abs(cmd.speed) == pytest.approx(BALANCE_SPEED)
+            # a wheel rolling backwards on a forward leg would read its torque with the wrong sign
+            assert math.copysign(1, cmd.speed * math.cos(cmd.steering)) == math.copysign(1, speed)
+        assert twist_at(plan, end + 0.5) == twist_at(plan, end + 2.5)  # standing: the pause

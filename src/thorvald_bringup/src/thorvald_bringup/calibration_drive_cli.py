@@ -18,18 +18,27 @@ line; otherwise one line) and no traceback.
 """
 
 import argparse
+import contextlib
+import io
+import json
 import os
 import sys
 import textwrap
 
+from thorvald_base.calibration.calibration_file import load_calibration
+from thorvald_base.calibration.torque_balance import relative_errors
 from thorvald_base.verification import SIDE
 from thorvald_model import ConfigError, load_robot_config
 from thorvald_sim.as_built import PROFILES, as_built_for
 
 from .errors import DriveError, ThorvaldBringupError
-from .odometry_report_cli import drive, robot_file
+from .odometry_report_cli import drive, robot_file, run_launch
 
 BAG = "calibration_drive.bag"
+CALIBRATION = "calibration.yaml"  # what base_driver loads: the final calibration
+ODOMETRY = "odometry_calibration.yaml"  # before the balance: calibrated from ground truth alone
+BALANCED = "balanced.yaml"  # balance_wheels': the radii where the wheels do not fight
+BALANCE_JSON = "balance.json"
 
 
 def parser() -> argparse.ArgumentParser:
@@ -51,6 +60,12 @@ def parser() -> argparse.ArgumentParser:
         help="calibrate against the simulator's (default) or the simulated RTK-GNSS and IMU, as on a real robot",
     )
     p.add_argument("--fit", choices=("drives", "odometry"), default="drives", help="calibrate_odometry's --fit")
+    balance = p.add_mutually_exclusive_group()
+    balance.add_argument(
+        "--balance", action="store_true", default=None,
+        help="then balance the wheels from their motor currents (default: a robot of more than two drives)",
+    )  # fmt: skip
+    balance.add_argument("--no-balance", dest="balance", action="store_false", help="calibrate from ground truth alone")
     p.add_argument("--out", metavar="DIR", default="calibration_drive", help="the bag's and the calibration's folder")
     p.add_argument("--json", action="store_true", help="print calibrate_odometry's results as JSON")
     p.add_argument("--real-time-factor", type=float, default=0.0, help="0: as fast as the machine can (default)")
@@ -78,7 +93,7 @@ def run(args) -> int:
         raise ThorvaldBringupError(f"--side: {args.side!r}: must be in (0, 1000) [m]")
     model = robot_file(args)
     config = load_robot_config(model)
-    as_built_for(args.as_built, config)  # refused here, before anything starts
+    built = as_built_for(args.as_built, config)  # refused here, before anything starts
     if args.as_built and args.as_built.partition(":")[0] not in PROFILES:
         args.as_built = os.path.abspath(args.as_built)
     out = os.path.abspath(args.out)
@@ -86,16 +101,117 @@ def run(args) -> int:
     bag = os.path.join(out, BAG)
     wall = drive(args, model, bag, "calibration", args.side)
     print(f"  drive: {wall:.1f} s wall; bag {bag}", flush=True)
+    balance = args.balance if args.balance is not None else fights(config)
     # ROS's Python (rosbag) only now: --help and bad robots stay fast
     from thorvald_base.calibration_cli import main as calibrate_odometry  # noqa: PLC0415
 
-    command = [bag, "--robot-model", model, "--out", os.path.join(out, "calibration.yaml")]
+    first = os.path.join(out, ODOMETRY if balance else CALIBRATION)
+    command = [bag, "--robot-model", model, "--out", first]
     command += ["--ground-truth", args.ground_truth, "--fit", args.fit]
     if args.calibration:
         command += ["--calibration", os.path.abspath(args.calibration)]
     if args.json:
         command.append("--json")
-    return calibrate_odometry(command)
+    if not balance:
+        return calibrate_odometry(command)
+    captured = io.StringIO()
+    with contextlib.redirect_stdout(captured):
+        status = calibrate_odometry(command)
+    text = captured.getvalue()
+    if status != 0 or not os.path.isfile(first):
+        print(text, end="")
+        return status or 2
+    if not args.json:
+        print(text, end="", flush=True)
+    balanced_file = os.path.join(out, BALANCED)
+    figures = os.path.join(out, BALANCE_JSON)
+    final = os.path.join(out, CALIBRATION)
+    for stale in (balanced_file, figures, final):
+        if os.path.exists(stale):
+            os.remove(stale)
+    launch_args = [f"robot_model:={model}", f"side:={args.side:g}", f"out:={balanced_file}", f"json:={figures}"]
+    log = os.path.join(out, "balance_wheels_launch.log")
+    wall, said = run_launch(
+        argparse.Namespace(**{**vars(args), "calibration": first}), "balance_wheels.launch", launch_args, log,
+        f"{os.path.basename(model)[:-5]} through the balance manoeuvre, its steering offsets calibrated",
+    )  # fmt: skip
+    if not (os.path.isfile(balanced_file) and os.path.isfile(figures)):
+        tail = "\n".join(said.splitlines()[-25:])
+        raise DriveError(f"the balancing drive did not finish (no balanced calibration); see {log}", tail)
+    with open(figures) as f:
+        balanced = json.load(f)
+    if not args.json:
+        start = said.find("balance_wheels: ")
+        print(f"  drive: {wall:.1f} s wall", flush=True)
+        print(said[start:].split("\n[", 1)[0].rstrip() if start >= 0 else "", flush=True)
+        print(
+            "\nthe calibration drive's fit, each radius moved to the balance's along what that drive did not determine:"
+        )
+    # the calibration drive's fit again, with the balance
+    captured = io.StringIO()
+    with contextlib.redirect_stdout(captured):
+        status = calibrate_odometry([*command[:4], final, *command[5:], "--balance", balanced_file])
+    if status != 0:
+        print(captured.getvalue(), end="")
+        return status
+    text = captured.getvalue()
+    tyres = None
+    if args.as_built:
+        tyres = tyre_errors(config, built, load_calibration(first, config), balanced, load_calibration(final, config))
+    if args.json:
+        result = json.loads(text[text.index("{") :])
+        result["balance"] = balanced
+        if tyres is not None:
+            result["tyres"] = tyres
+        print(json.dumps(result, indent=2))
+        return 0
+    print(text, end="")
+    if tyres is not None:
+        names = ("configured", "ground_truth", "balanced", "calibration")
+        largest = [tyres[k]["largest_percent"] for k in names]
+        relative = [tyres[k]["largest_relative_percent"] for k in names]
+        print(
+            "each tyre's radius against the as-built robot's, the largest error [%]: configured {:.2f}, from ground "
+            "truth {:.2f}, balanced {:.2f}, the calibration {:.2f} (each against the others only: {:.2f}, {:.2f}, "
+            "{:.2f}, {:.2f})".format(*largest, *relative)
+        )
+    return 0
+
+
+def fights(config) -> bool:
+    """Whether the robot's wheels can fight: more than two driven wheels on one rigid frame (two on
+    one axle roll as they must, and ground truth tells their radii apart by the heading)."""
+    return len(config.drives) > 2
+
+
+def tyre_errors(config, built, odometry_changes, balanced, final_changes) -> dict:
+    """Each tyre's radius against the as-built robot's [%]: configured, calibrated from ground truth,
+    balanced, and the calibration; absolute and with the common factor removed (what the balance alone
+    can tell)."""
+    truth = [d.r_wheel for d in built.drives]
+
+    def radii(changes):
+        fitted = config
+        for index, key, value in changes:
+            fitted = fitted.with_drive_param(index, key, value)
+        return [d.r_wheel for d in fitted.drives]
+
+    sets = {
+        "configured": radii([]),
+        "ground_truth": radii(odometry_changes),
+        "balanced": [balanced["drives"][f"drive{k}"]["r_wheel"] for k in range(len(config.drives))],
+        "calibration": radii(final_changes),
+    }
+    out = {}
+    for name, radii in sets.items():
+        errors = [100.0 * (r / t - 1.0) for r, t in zip(radii, truth)]
+        relative = 100.0 * relative_errors(radii, truth)
+        out[name] = {
+            "errors_percent": errors,
+            "largest_percent": max(abs(e) for e in errors),
+            "largest_relative_percent": float(max(abs(relative))),
+        }
+    return out
 
 
 __all__ = ["main", "parser", "run"]

@@ -102,31 +102,41 @@ def robot_file(args) -> str:
 def drive(args, model: str, bag: str, manoeuvre: str = "verification", side: float = SIDE) -> float:
     """Runs odometry_report.launch until the drive ends; returns the wall time [s]. args: world,
     real_time_factor, gui, as_built, calibration, timeout."""
+    for stale in (bag, bag + ".active"):
+        if os.path.exists(stale):
+            os.remove(stale)
+    log = os.path.join(os.path.dirname(bag), "odometry_report_launch.log")
+    wall, text = run_launch(
+        args, "odometry_report.launch", [f"robot_model:={model}", f"bag:={bag}", f"manoeuvre:={manoeuvre}",
+        f"side:={side:g}"], log, f"{os.path.basename(model)[:-5]} through the {manoeuvre} manoeuvre",
+    )  # fmt: skip
+    if "Verification drive of" not in text or not os.path.isfile(bag):
+        tail = "\n".join(text.splitlines()[-25:])
+        raise DriveError(f"the drive did not finish (no report from verification_drive or no bag); see {log}", tail)
+    return wall
+
+
+def run_launch(args, launch: str, launch_args, log: str, what: str):
+    """Runs thorvald_bringup's launch file with launch_args and the simulated robot's (args: world,
+    real_time_factor, gui, as_built, calibration, timeout) on a ROS master of its own until it ends;
+    (wall time [s], what it printed). Its output goes to log."""
     port = free_port()
     env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}")
-    log = os.path.join(os.path.dirname(bag), "odometry_report_launch.log")
     cmd = [
         "roslaunch",
         "-p",
         str(port),
         "thorvald_bringup",
-        "odometry_report.launch",
-        f"robot_model:={model}",
+        launch,
+        *launch_args,
         f"world:={args.world}",
-        f"bag:={bag}",
         f"real_time_factor:={args.real_time_factor:g}",
         f"with_gui:={'true' if args.gui else 'false'}",
         f"as_built:={args.as_built}",
         f"calibration:={os.path.abspath(args.calibration) if args.calibration else ''}",
-        f"manoeuvre:={manoeuvre}",
-        f"side:={side:g}",
     ]
-    for stale in (bag, bag + ".active"):
-        if os.path.exists(stale):
-            os.remove(stale)
     print(
-        f"Driving {os.path.basename(model)[:-5]}{' as built ' + args.as_built if args.as_built else ''} through the "
-        f"{manoeuvre} manoeuvre on {args.world} "
+        f"Driving {what}{' as built ' + args.as_built if args.as_built else ''} on {args.world} "
         f"(simulator, measured drives, ROS master on port {port}; log {log})",
         flush=True,
     )
@@ -145,11 +155,7 @@ def drive(args, model: str, bag: str, manoeuvre: str = "verification", side: flo
             raise
     wall = time.time() - start
     with open(log) as f:
-        text = f.read()
-    if "Verification drive of" not in text or not os.path.isfile(bag):
-        tail = "\n".join(text.splitlines()[-25:])
-        raise DriveError(f"the drive did not finish (no report from verification_drive or no bag); see {log}", tail)
-    return wall
+        return wall, f.read()
 
 
 def report_json(report, as_built: str, world: str) -> dict:

@@ -6,6 +6,9 @@ through the gear to the motor shaft, through the motor's constants to the windin
 electrical power, summed with the hotel load (computers, sensors), and drawn from the battery,
 whose internal resistance makes the current for a power higher than power / voltage.
 
+The motor, its winding current and its power are the drives' one model (:mod:`thorvald_model.motors`;
+``Motor`` is re-exported here); this module applies it to arrays and adds the battery and the run.
+
 Pure: stdlib and numpy only; no rospy, no pybullet, no messages. SI units throughout (energy also
 in Wh and charge in Ah, as batteries are rated).
 """
@@ -16,39 +19,13 @@ from typing import Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
+from thorvald_model.motors import Motor, electrical_power, winding_current
+
 ArrayLike = Union[float, Sequence[float], np.ndarray]
 SECONDS_PER_HOUR = 3600.0
 # a run that used less than this fraction of the capacity used nothing (rounding of regeneration that gives
 # back what was drawn): no range, rather than a range of 1e19 km
 NOTHING_USED = 1e-9
-
-
-@dataclass(frozen=True)
-class Motor:
-    """One DC motor (a brushless one modelled as DC) with its gear.
-
-    torque_constant k_t [N m/A], in SI equal to the back-EMF constant k_e [V s/rad]: the power
-    conversion k_t i w = k_e w i balances only when they are the same number; resistance R [ohm] of
-    the winding; no_load_current i_0 [A], the current that turns the unloaded motor (its friction
-    torque is k_t i_0); gear_ratio G, motor turns per output turn; gear_efficiency eta in (0, 1]."""
-
-    torque_constant: float
-    resistance: float
-    no_load_current: float
-    gear_ratio: float
-    gear_efficiency: float
-
-    def __post_init__(self):
-        rules = (
-            ("torque_constant", self.torque_constant > 0.0, "> 0"),
-            ("resistance", self.resistance >= 0.0, ">= 0"),
-            ("no_load_current", self.no_load_current >= 0.0, ">= 0"),
-            ("gear_ratio", self.gear_ratio > 0.0, "> 0"),
-            ("gear_efficiency", 0.0 < self.gear_efficiency <= 1.0, "in (0, 1]"),
-        )
-        for name, ok, rule in rules:
-            if not (ok and math.isfinite(getattr(self, name))):
-                raise ValueError(f"motor: {name} {getattr(self, name)!r}: must be {rule}")
 
 
 @dataclass(frozen=True)
@@ -76,6 +53,11 @@ class Battery:
         return math.inf if r == 0.0 else self.voltage**2 / (4.0 * r)
 
 
+# the shared scalar model elementwise over broadcast arrays (the motor passed whole, not as an array)
+_WINDING_CURRENT = np.vectorize(winding_current, otypes=[float], excluded={0})
+_ELECTRICAL_POWER = np.vectorize(electrical_power, otypes=[float], excluded={0})
+
+
 def _out(a: np.ndarray) -> Union[float, np.ndarray]:
     """A 0-d array as a float, others as they are."""
     return float(a) if np.ndim(a) == 0 else a
@@ -87,18 +69,12 @@ def motor_power(
     """(electrical power [W] drawn, winding current [A]) of a motor whose gear output turns at
     output_speed w [rad/s] under output_torque tau [N m]; numpy arrays broadcast, floats give floats.
 
-    Gear: the motor turns at w_m = G w. Power flows through the gear with loss eta the way it flows:
-    when the output delivers power to the load (tau w >= 0, motoring, holding at standstill
-    included) the motor supplies more than arrives, tau_m w_m = tau w / eta, so tau_m = tau / (G eta);
-    when the load drives the output back (tau w < 0, braking, going downhill) the motor receives less
-    than was put in, tau_m w_m = eta tau w, so tau_m = tau eta / G.
-
-    Motor: torque needs current, tau_m = k_t i, and the motor's own friction k_t i_0 opposes its
-    turning, so i = tau_m / k_t + sign(w_m) i_0 (i_0 only while turning). The winding's voltage is
-    the back-EMF plus the resistive drop, v = k_e w_m + i R (k_e = k_t in SI), and the electrical power
-    P = v i = k_t w_m i + i^2 R: the mechanical power at the shaft plus the copper loss. So holding a
-    torque at standstill costs i^2 R = (tau / (G eta k_t))^2 R, and an unloaded motor at speed w costs
-    k_e G w i_0 + i_0^2 R.
+    Both are the drives' one motor model's (:mod:`thorvald_model.motors`): the winding current
+    i = tau_m / k_t + sign(w_m) i_0, with the gear's loss taken the way the power flows
+    (:func:`~thorvald_model.motors.winding_current`), and the power P = v i = k_t w_m i + i^2 R, the
+    mechanical power at the shaft plus the copper loss (:func:`~thorvald_model.motors.electrical_power`).
+    So holding a torque at standstill costs i^2 R = (tau / (G eta k_t))^2 R, and an unloaded motor at
+    speed w costs k_e G w i_0 + i_0^2 R.
 
     P < 0 is a motor generating (its mechanical power returned exceeds its copper loss). With
     regenerative False the controller dissipates that (a braking resistor) and the power drawn is 0;
@@ -106,12 +82,8 @@ def motor_power(
     winding current i (for the motor's and the controller's ratings), whichever way the power goes."""
     tau = np.asarray(output_torque, dtype=float)
     w = np.asarray(output_speed, dtype=float)
-    g, eta, kt = motor.gear_ratio, motor.gear_efficiency, motor.torque_constant
-    w_m = g * w
-    tau_m = np.where(tau * w >= 0.0, tau / (g * eta), tau * eta / g)
-    current = tau_m / kt + np.sign(w_m) * motor.no_load_current
-    voltage = kt * w_m + current * motor.resistance
-    power = voltage * current
+    current = _WINDING_CURRENT(motor, tau, w)
+    power = _ELECTRICAL_POWER(motor, tau, w)
     if not regenerative:
         power = np.maximum(power, 0.0)
     return _out(power), _out(current)

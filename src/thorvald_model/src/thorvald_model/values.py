@@ -86,10 +86,11 @@ class Drive:
     # enough to turn a loaded wheel on the spot on tarmac.
     prp_motor_torque: float = key(1.6, **POSITIVE)  # [N m]
     str_motor_torque: float = key(1.0, **POSITIVE)  # [N m]
-    # Ours: the motors as DC motors behind their gears, for energy (thorvald_design.energy). A 48 V
-    # motor of 3000 rpm has a back-EMF constant near 48 V x 0.9 / 314 rad/s = 0.14 V s/rad, which in SI
-    # is its torque constant [N m/A]: 1.6 N m takes 11 A. Windings of a quarter ohm, 0.6 A without load,
-    # and a two-stage planetary gear's 90 % (steering: 0.4 ohm, 0.4 A, 85 %).
+    # Ours: the motors as DC motors behind their gears (thorvald_model.motors), for the simulator's motor
+    # currents (drive_currents) and energy (thorvald_design.energy). A 48 V motor of 3000 rpm has a
+    # back-EMF constant near 48 V x 0.9 / 314 rad/s = 0.14 V s/rad, which in SI is its torque constant
+    # [N m/A]: 1.6 N m takes 11 A. Windings of a quarter ohm, 0.6 A without load, and a two-stage
+    # planetary gear's 90 % (steering: 0.4 ohm, 0.4 A, 85 %).
     prp_motor_kt: float = key(0.14, **POSITIVE)  # [N m/A] torque constant (= back-EMF constant [V s/rad])
     prp_motor_r: float = key(0.25, **NON_NEGATIVE)  # [ohm] winding resistance
     prp_motor_i0: float = key(0.6, **NON_NEGATIVE)  # [A] no-load current

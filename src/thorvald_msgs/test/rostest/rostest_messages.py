@@ -14,6 +14,7 @@ from thorvald_msgs.msg import (
     CANFrame,
     Controller,
     ControllerArray,
+    DriveCurrents,
     IOArray,
     IOData,
     MotorVars,
@@ -77,6 +78,15 @@ class MessagesRoundTrip(unittest.TestCase):
         self.assertIsNotNone(got)
         self.assertEqual(got.controllers[0].status_flags[0].status_name, "stall detected")
         self.assertEqual(got.controllers[0].motor_vars[1].position, 0.3)
+
+    def test_drive_currents(self):
+        sent = DriveCurrents(prop_amps=[1.5, -0.84], steer_amps=[0.4, 0.0])
+        sent.header.stamp = rospy.Time(3, 25)
+        got = round_trip("drive_currents", DriveCurrents, sent)
+        self.assertIsNotNone(got)
+        self.assertEqual(list(got.prop_amps), [1.5, -0.84])
+        self.assertEqual(list(got.steer_amps), [0.4, 0.0])
+        self.assertEqual(got.header.stamp, rospy.Time(3, 25))
 
     def test_io_array(self):
         got = round_trip("io_data", IOArray, IOArray(ios=[IOData(id=0, type=0, relay_states=[True, False])]))

@@ -78,6 +78,12 @@ class Profile:
     loaded: Tuple[float, float] = (0.0, 0.0)
 
 
+# A loaded pneumatic tyre's deflection is about three times the drop of its rolling radius (above): a
+# profile's loaded tyres give this times its draw of the radius under their share of the weight, so a
+# frame of more than three wheels stands on all of them, as tyres do (rigid ones of radii a millimetre
+# apart left a six-wheeled frame on two wheels, the others turning in the air)
+TYRE_DEFLECTION_PER_LOADED = 3.0
+
 PROFILES: Dict[str, Profile] = {
     # A field robot: tyre pressure and wear +-1 % of the rolling radius per tyre, steering homed within
     # +-0.5 deg, the encoders counting as configured; and its tyres loaded: a pneumatic tyre under a
@@ -267,6 +273,9 @@ class SimAsBuilt:
     drives: Tuple[BuiltDrive, ...]
     delay: float = 0.0  # [s]
     mass_offset: float = 0.0  # [kg]
+    # [m] how far each tyre gives under its share of the robot's weight (pneumatic tyres: a soft contact
+    # whose stiffness is that share over this); 0: rigid tyres, as configured
+    tyre_deflection: float = 0.0
 
     def to_json(self) -> str:
         return json.dumps(
@@ -275,6 +284,7 @@ class SimAsBuilt:
                 "drives": [dataclasses.asdict(d) for d in self.drives],
                 "delay": self.delay,
                 "mass_offset": self.mass_offset,
+                "tyre_deflection": self.tyre_deflection,
             }
         )
 
@@ -289,14 +299,19 @@ class SimAsBuilt:
                 tuple(BuiltDrive(**{k: float(v) for k, v in d.items()}) for d in data["drives"]),
                 float(data["delay"]),
                 float(data["mass_offset"]),
+                float(data.get("tyre_deflection", 0.0)),
             )
         except (ValueError, TypeError, KeyError) as e:
             raise ValueError(f"the as-built robot is not readable ({type(e).__name__}: {e})") from None
-        values = [built.delay, built.mass_offset] + [v for d in built.drives for v in dataclasses.astuple(d)]
+        values = [built.delay, built.mass_offset, built.tyre_deflection] + [
+            v for d in built.drives for v in dataclasses.astuple(d)
+        ]
         if drives is not None and len(built.drives) != drives:
             raise ValueError(f"the as-built robot has {len(built.drives)} drives, the description {drives}")
         if not all(math.isfinite(v) for v in values) or any(d.r_wheel <= 0 for d in built.drives):
             raise ValueError("the as-built robot's values must be finite, its radii > 0")
+        if built.tyre_deflection < 0:
+            raise ValueError("the as-built robot's tyre deflection must be >= 0")
         return built
 
 
@@ -317,7 +332,8 @@ def for_simulator(as_built: AsBuilt, config: RobotConfig) -> SimAsBuilt:
                 "steering_rate_step": scaling.steering_rate(1.0) if drive.steerable else 0.0,
             }
         drives.append(BuiltDrive(built.r_wheel, built.steering_offset, **counts))
-    return SimAsBuilt(as_built.source, tuple(drives), as_built.delay, as_built.mass_offset)
+    deflection = TYRE_DEFLECTION_PER_LOADED * as_built.loaded * sum(as_built.configured) / len(as_built.configured)
+    return SimAsBuilt(as_built.source, tuple(drives), as_built.delay, as_built.mass_offset, deflection)
 
 
 def describe_as_built(built: AsBuilt) -> str:

@@ -2,7 +2,9 @@
 
 From the generator's simulator block (``<gazebo><plugin>``, as the original generator emitted it for
 its Gazebo plugin): the command and odometry topics, the odometry and base frames, and one
-``<drive>`` per drive in drive order (steering joint, wheel joint, wheel radius). From the joints:
+``<drive>`` per drive in drive order (steering joint, wheel joint, wheel radius, acceleration limit,
+and its motors under the robot file's keys, ``prp_motor_kt`` ... ``str_gear_eff``: a key the element
+lacks, as from an older generator, is the robot file's default). From the joints:
 the motors' limits (``<limit effort velocity>``), the suspension springs (``<springStiffness>`` in
 the joint's ``<gazebo reference>`` and the joint's damping) and the passive joints (casters, support
 wheels) with their friction. A URDF without the block (any other robot) is a passive model.
@@ -12,12 +14,15 @@ import copy
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
+from types import SimpleNamespace
 from typing import Callable, Dict, Iterable, List, Mapping, Optional, Tuple
 
 from thorvald_model.datum import Datum, parse_datum
 from thorvald_model.errors import ConfigError
 from thorvald_model.joint_tree import Origin, ParentJoint, UrdfError  # noqa: F401  (Origin: for the sensors)
 from thorvald_model.joint_tree import link_tree as _link_tree
+from thorvald_model.keys import DRIVE_KEYS
+from thorvald_model.motors import PROPULSION_KEYS, STEERING_KEYS, Motor, propulsion_motor, steering_motor
 from thorvald_model.urdf_check import checked_tree, normalize_frame
 
 from .errors import DescriptionError
@@ -34,6 +39,12 @@ class JointInfo:
     friction: float  # [N m] or [N]
 
 
+# The robot file's keys a drive's motors are made of, with their defaults (a Thorvald module's).
+MOTOR_KEYS = {k.name: k.default for k in DRIVE_KEYS if k.name in PROPULSION_KEYS + STEERING_KEYS}
+DEFAULT_PROPULSION_MOTOR = propulsion_motor(SimpleNamespace(**MOTOR_KEYS))
+DEFAULT_STEERING_MOTOR = steering_motor(SimpleNamespace(**MOTOR_KEYS))
+
+
 @dataclass(frozen=True)
 class DriveJoints:
     """One drive of the simulator block: the joints base_state's entry of index ``index`` moves."""
@@ -44,6 +55,8 @@ class DriveJoints:
     wheel_joint: str
     wheel_radius: float  # [m]
     max_acceleration: float = 0.0  # the drive controller's rim acceleration limit [m/s^2]; 0: none
+    propulsion_motor: Motor = DEFAULT_PROPULSION_MOTOR  # its motors behind their gears (thorvald_model.motors)
+    steering_motor: Motor = DEFAULT_STEERING_MOTOR  # a drive that does not steer has one too: nothing reads it
 
 
 @dataclass(frozen=True)
@@ -143,6 +156,7 @@ def description_of(root: ET.Element) -> RobotDescription:
             e.get("wheel_joint", ""),
             _float(e.get("wheel_radius"), f"drive {index} wheel_radius"),
             _float(e.get("max_acceleration"), f"drive {index} max_acceleration"),
+            *_motors(e, index),
         )
         for joint in (drive.wheel_joint, drive.steering_joint):
             if joint not in joints:
@@ -162,6 +176,19 @@ def description_of(root: ET.Element) -> RobotDescription:
         normalize_frame(plugin.findtext("robotBaseFrame") or "base_link"),
         _datum(plugin.find("datum")),
     )
+
+
+def _motors(element: ET.Element, index: int) -> Tuple[Motor, Motor]:
+    """A ``<drive>``'s (propulsion, steering) motors from its attributes, defaults for those it lacks."""
+    values = {
+        name: _float(element.get(name), f"drive {index} {name}") if element.get(name) is not None else default
+        for name, default in MOTOR_KEYS.items()
+    }
+    keys = SimpleNamespace(**values)
+    try:
+        return propulsion_motor(keys), steering_motor(keys)
+    except ValueError as e:
+        raise DescriptionError(f"drive {index}: {e}") from None
 
 
 def _datum(element) -> Optional[Datum]:

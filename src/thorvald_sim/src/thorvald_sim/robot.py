@@ -25,8 +25,9 @@ No ROS here: the simulator node converts messages. The pybullet client id is pas
 * As built (:mod:`thorvald_sim.as_built`, optional): wheels of their true rolling radii (the
   collision cylinders; the controllers still convert with the configured radius, as real ones do),
   steering modules homed off by their offsets (a command of a goes to a + offset, a measured a + offset
-  reads a), the encoders' whole counts and whole motor rpm in what is reported, measurements reported
-  ``delay`` late (the newest one at least that old), and a load of ``mass_offset`` on the frame.
+  reads a), the encoders' whole counts and whole motor rpm in what is reported, measurements (drive
+  states, motor currents) reported ``delay`` late (the newest one at least that old), and a load of
+  ``mass_offset`` on the frame.
 """
 
 import contextlib
@@ -42,6 +43,7 @@ from typing import List, Optional, Sequence, Tuple, Union
 import pybullet as p
 
 from thorvald_base.bases import MeasuredDrive
+from thorvald_model.motors import winding_current
 
 from .as_built import BuiltDrive, SimAsBuilt
 from .description import (
@@ -58,6 +60,9 @@ LINK_FRICTION = 1.0
 STEERING_POSITION_GAIN = 0.5  # pybullet's servo gain: fraction of the position error closed per step
 TYRE_CONTACT_WIDTH = 0.01  # [m]: the wheels' collision discs (see with_tyre_contact)
 FOLLOW_HEADROOM = 2.0  # following states, the steering servo may turn this much faster than the drive
+
+
+GRAVITY = 9.81  # [m/s^2]: a tyre's deflection is rated under its share of the weight at standard gravity
 
 
 @dataclass(frozen=True)
@@ -112,6 +117,7 @@ class SimRobot:
             list(as_built.drives) if as_built else [BuiltDrive(d.wheel_radius, 0.0) for d in description.drives]
         )
         self._history = deque()  # (time, drive states) measured, while reports are delayed
+        self._current_history = deque()  # (time, drive currents) likewise
         self._drive_joints = None  # the joints a drive state reads, in one getJointStates call
         self.client = client
         self.name = name
@@ -154,10 +160,24 @@ class SimRobot:
         self._inertial = (tuple(dyn[3]), tuple(dyn[4]))  # centre of mass in base_link
         self._to_base_link = p.invertTransform(*self._inertial)
         self._setup_joints()
+        if as_built is not None and as_built.tyre_deflection > 0:
+            self._soften_tyres(as_built.tyre_deflection)
         self._odom = ((pose.x, pose.y, 0.0), p.getQuaternionFromEuler((0.0, 0.0, pose.yaw)))
         self._odom_inverse = p.invertTransform(*self._odom)
 
     # ---- set-up ---------------------------------------------------------------------------
+    def _soften_tyres(self, deflection: float) -> None:
+        """Pneumatic tyres: each wheel's contact gives deflection [m] under its share of the robot's
+        weight (a spring of that share over deflection, critically damped for the share's mass), so the
+        weight spreads over every wheel as tyres spread it. The wheel still rolls on its radius."""
+        c, body = self.client, self.body
+        links = range(-1, p.getNumJoints(body, physicsClientId=c))
+        share = sum(p.getDynamicsInfo(body, link, physicsClientId=c)[0] for link in links) / len(self.wheels)  # [kg]
+        stiffness = share * GRAVITY / deflection
+        damping = 2.0 * math.sqrt(stiffness * share)
+        for joint, _, _ in self.wheels:
+            p.changeDynamics(body, joint, contactStiffness=stiffness, contactDamping=damping, physicsClientId=c)
+
     def _setup_joints(self) -> None:
         c, body, d = self.client, self.body, self.description
         # pybullet gives every body a velocity damping of 0.04 /s, a drag no robot has. Damping belongs
@@ -288,10 +308,14 @@ class SimRobot:
             MeasuredDrive(*b.measured(s.steering, s.speed, s.wheel_angle, s.steering_speed))
             for s, b in zip(self._joint_drive_states(), self.built)
         ]
-        if self.as_built.delay <= 0 or now is None:
-            return states
-        history = self._history
-        history.append((now, states))
+        return self._reported(self._history, now, states)
+
+    def _reported(self, history: deque, now: Optional[float], measured):
+        """As built with a delay: the newest of the measurements kept in history taken at least the delay
+        before now [s] (measured is taken now); without one (or without now), measured."""
+        if self.as_built is None or self.as_built.delay <= 0 or now is None:
+            return measured
+        history.append((now, measured))
         while len(history) > 1 and history[1][0] <= now - self.as_built.delay + 1e-9:  # 1 ns: rounding
             history.popleft()
         return history[0][1]
@@ -326,6 +350,24 @@ class SimRobot:
             s = next(read) if steer is not None else (0.0, 0.0, None, 0.0)
             out.append(MotorLoad(w[3], w[1], s[3], s[1]))
         return out
+
+    def drive_currents(self, now: Optional[float] = None) -> List[Tuple[float, float]]:
+        """What each drive's motor controller measures of its motors: (propulsion, steering) winding
+        currents [A], the joints' motor torques and rates (:meth:`motor_torques`) through the drive's
+        motors and gears (:func:`thorvald_model.motors.winding_current`, with the description's motor
+        constants, the robot file's). Positive when the torque turns the wheel forward, or to the
+        left; 0 steering amps for a drive that does not steer. As built, reported with the drive
+        states' delay (over the same controllers); the true radii change the torques, not the model."""
+        currents = []
+        for drive, load in zip(self.description.drives, self.motor_torques()):
+            prop = winding_current(drive.propulsion_motor, load.wheel_torque, load.wheel_rate)
+            steer = (
+                winding_current(drive.steering_motor, load.steering_torque, load.steering_rate)
+                if drive.steerable
+                else 0.0
+            )
+            currents.append((prop, steer))
+        return self._reported(self._current_history, now, currents)
 
     def wheel_loads(self) -> List[float]:
         """[N] the normal force the world puts on each drive's wheel at the last step (its contact
@@ -394,6 +436,7 @@ class SimRobot:
         for j in self.joint_index.values():
             p.resetJointState(self.body, j, 0.0, 0.0, physicsClientId=c)
         self._history.clear()
+        self._current_history.clear()
         self.hold()
 
     def remove(self) -> None:

@@ -195,11 +195,13 @@ def stamp_time(t: float) -> float:
 
 class _SimulatedDrives:
     """The handle's ports to a robot of this process: commands straight to its joints, its measured
-    states handed over each tick (what the simulator's drive_commands and drive_states carry)."""
+    motor currents and states handed over each tick (what the simulator's drive_commands,
+    drive_currents and drive_states carry)."""
 
     def __init__(self, robot):
         self.robot = robot
         self.on_states = None
+        self.on_currents = None
 
     def send(self, commands, time, drives):
         self.robot.command(
@@ -209,15 +211,26 @@ class _SimulatedDrives:
     def listen(self, on_states):
         self.on_states = on_states
 
+    def listen_currents(self, on_currents):
+        self.on_currents = on_currents
+
+    def measured(self, t: float) -> None:
+        """Hands over the robot's measurement of instant t [s]: the currents first, then the states
+        (which the lockstep handle waits for), as the simulator publishes them."""
+        if self.on_currents is not None:
+            currents = self.robot.drive_currents(t)
+            self.on_currents([c[0] for c in currents], [c[1] for c in currents], t)
+        self.on_states(self.robot.drive_states(t), t)
+
     def close(self):
-        self.on_states = None
+        self.on_states = self.on_currents = None
 
 
 class _InProcessPorts(Ports):
     def __init__(self, drives: _SimulatedDrives):
         self.drives = drives
 
-    def drive_topics(self, command_topic, state_topic):
+    def drive_topics(self, command_topic, state_topic, current_topic="drive_currents"):
         return self.drives
 
 
@@ -308,7 +321,7 @@ class RobotSession:
             if not clock.due(now):
                 continue
             t = stamp_time(now)
-            drives.on_states(robot.drive_states(t), t)
+            drives.measured(t)
             if not steps.due(t):
                 steps.answer(t)
                 continue

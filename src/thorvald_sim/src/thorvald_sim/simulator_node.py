@@ -19,7 +19,7 @@ Private parameters:
 ``~clock_rate``           /clock messages per simulated second [Hz] (80: every third step at 240 Hz
                           physics; at most one a step)
 ``~odometry_rate``        odometry/gazebo and joint_states per simulated second [Hz] (50)
-``~drive_state_rate``     drive_states per simulated second [Hz] (80)
+``~drive_state_rate``     drive_states (and drive_currents) per simulated second [Hz] (80)
 ``~command_timeout``      a robot whose commands stop for this long [s] stops its wheels (0.5)
 ``~max_lag``              the simulator waits for a robot whose commands lag more than this behind
                           simulated time [s] (0.05; 0: never): a busy machine slows the
@@ -64,7 +64,10 @@ Per robot, in its namespace: subscribes the command topic (``base_state``, as th
 or base_driver's ``drive_commands`` with measured drives); publishes ``odometry/gazebo``
 (nav_msgs/Odometry: ``<tf_prefix>odom`` at the spawn pose -> ``<tf_prefix>base_link``, the twist in
 base_link), ``joint_states`` of the joints base_driver does not report (casters, support wheels,
-suspension) and ``drive_states`` (thorvald_msgs/BaseState: what each drive's encoders measure).
+suspension), ``drive_states`` (thorvald_msgs/BaseState: what each drive's encoders measure) and, just
+before them, ``drive_currents`` (thorvald_msgs/DriveCurrents: each drive's motor currents, as its motor
+controller measures them: the joints' motor torques through the drive's motors and gears, with the
+motor constants of the description's simulator block, the robot file's); each only while read.
 
 Per robot, unless its spawn or ``~publish_tf`` say no, ``/tf`` carries ``<tf_prefix>odom ->
 <tf_prefix>base_link`` from ground truth, the transform of ``odometry/gazebo``. Another node publishing
@@ -99,7 +102,7 @@ from thorvald_base.publishing import NonBlockingPublisher, recorded_publisher
 from thorvald_base.rate_grid import RateGrid
 from thorvald_model import ConfigError
 from thorvald_model.datum import load_datum
-from thorvald_msgs.msg import BaseState
+from thorvald_msgs.msg import BaseState, DriveCurrents
 from thorvald_msgs.srv import (
     DeleteRobot,
     DeleteRobotResponse,
@@ -140,6 +143,7 @@ class RobotIO:
         self.odom_pub = recorded_publisher(node.lockstep)(ns + d.odometry_topic, Odometry)
         self.joint_pub = NonBlockingPublisher(ns + "joint_states", JointState)
         self.drive_pub = NonBlockingPublisher(ns + "drive_states", BaseState)
+        self.current_pub = NonBlockingPublisher(ns + "drive_currents", DriveCurrents)
         self.commands = CommandSlot(len(robot.wheels))  # the latest, to apply in the loop
         self.node = node
         self.sub = rospy.Subscriber(ns + command_topic, BaseState, self.on_command, queue_size=1)
@@ -199,8 +203,14 @@ class RobotIO:
         return conversions.odometry_transform(msg) if self.publish_tf and tf_read else None
 
     def publish_drives(self, stamp):
+        now = stamp.to_sec()
+        # the currents first: a lockstep base_driver runs its cycle once the instant's states came
+        if self.current_pub.get_num_connections():
+            currents = self.robot.drive_currents(now)
+            self.current_pub.publish(
+                conversions.currents_msg(stamp, [c[0] for c in currents], [c[1] for c in currents])
+            )
         if self.drive_pub.get_num_connections():  # base_driver with measured drives
-            now = stamp.to_sec()
             # its reader is there: in lockstep from its first drive states on, not its first answer
             if self.node.lockstep and self.node.waits.published(self.robot.name, now):
                 rospy.loginfo("simulator: %s in lockstep", self.robot.name)
@@ -208,7 +218,7 @@ class RobotIO:
 
     def close(self):
         self.sub.unregister()
-        for pub in (self.odom_pub, self.joint_pub, self.drive_pub):
+        for pub in (self.odom_pub, self.joint_pub, self.drive_pub, self.current_pub):
             pub.unregister()
         self.sensors.close()
 

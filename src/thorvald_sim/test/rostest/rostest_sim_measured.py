@@ -5,6 +5,7 @@ On tarmac, 10 m at 1 m/s: odometry's distance within 2 % of ground truth's. On i
 the robot starts from rest at 1 m/s: its wheels ramp up at their controllers' 1.5 m/s^2, the robot
 can accelerate at mu g = 0.98 m/s^2 at most, so ground truth falls behind odometry: the slip is real.
 (Until the wheels' friction was really 1.0, they had 0.5 and the ice 0.05: about 0.5 m against 1 m.)
+At speed, base_driver's motor controllers report the simulated motors' currents (drive_currents).
 """
 
 import unittest
@@ -13,7 +14,7 @@ import rospy
 import rostest
 from sim_testing import Commander, Latest, delta, planar, sim_sleep
 
-from thorvald_msgs.msg import BaseState
+from thorvald_msgs.msg import BaseState, ControllerArray
 
 
 class SimMeasuredTest(unittest.TestCase):
@@ -23,6 +24,7 @@ class SimMeasuredTest(unittest.TestCase):
         cls.odometry = {r: Latest(f"/{r}/odometry/base_raw") for r in ("tarmac", "ice")}
         cls.nav = {r: Commander(f"/{r}/nav_vel") for r in ("tarmac", "ice")}
         cls.measured = Latest("/tarmac/drive_states", BaseState)
+        cls.controllers = Latest("/tarmac/motor_controller_data", ControllerArray)
         for r in ("tarmac", "ice"):
             cls.truth[r].wait()
             cls.odometry[r].wait()
@@ -50,8 +52,19 @@ class SimMeasuredTest(unittest.TestCase):
     def test_odometry_follows_ground_truth_over_10_m_of_tarmac(self):
         # at speed, the drive states are the simulator's: base_driver reads its wheels' measured rim speed
         self.nav["tarmac"].send(1.0)
+        sent = rospy.get_time()
         sim_sleep(2.0)
         self.assertAlmostEqual(self.measured.get().prop_speed[0], 1.0, delta=0.05)
+        # and its motor controllers (1 Hz) the simulated motors' currents: at 1 m/s on tarmac every wheel
+        # pushes, at least its motor's no-load current (0.6 A) forward
+        status = self.controllers.after(rospy.Time.from_sec(sent + 1.0))
+        prop = [c.motor_vars[0] for c in status.controllers]
+        rospy.loginfo("tarmac: propulsion currents %s A", ", ".join(f"{v.motor_amps:.3f}" for v in prop))
+        self.assertEqual(len(prop), 4)
+        for v in prop:
+            self.assertEqual(v.type, "propulsion")
+            self.assertAlmostEqual(v.speed, 1.0, delta=0.1)
+            self.assertGreater(v.motor_amps, 0.0)
         self.nav["tarmac"].send()
         sim_sleep(1.5)
         # compared at rest: sampled while moving at 1 m/s, 0.1 s between the deliveries of the two

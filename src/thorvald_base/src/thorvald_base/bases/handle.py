@@ -79,7 +79,8 @@ class IoInfo:
 
 
 class DriveTopics:
-    """Drive commands out and measured drive states in, over the node's topics (a simulator's).
+    """Drive commands out, measured drive states and motor currents in, over the node's topics (a
+    simulator's).
 
     The node makes it (base_driver_node.RosPorts); a handle only calls it, so no handle imports
     rospy or a message type.
@@ -94,14 +95,20 @@ class DriveTopics:
         """on_states(states in drive order, their time [s]) for each measurement that arrives."""
         raise NotImplementedError
 
+    def listen_currents(self, on_currents: Callable[[List[float], List[float], float], None]) -> None:
+        """on_currents(propulsion amps, steering amps, their time [s]), the motor currents [A] in drive
+        order, for each measurement that arrives (a simulator's that reports none: never)."""
+
     def close(self) -> None:
-        """Stops both."""
+        """Stops sending and listening."""
 
 
 class Ports:
     """What base_driver's node offers a handle besides the configuration and parameters."""
 
-    def drive_topics(self, command_topic: str, state_topic: str) -> DriveTopics:
+    def drive_topics(self, command_topic: str, state_topic: str, current_topic: str = "drive_currents") -> DriveTopics:
+        """The drives' commands out, their states and motor currents in, on these topics (names the
+        node resolves as its own)."""
         raise NotImplementedError
 
 

@@ -7,9 +7,17 @@ over CAN. Odometry then sees what a real robot's encoders see: torque limits, sl
 slip. The simulator knows nothing of base_driver beyond these two topics (thorvald_sim follows
 ``drive_commands`` when a robot is spawned with ``-command_topic drive_commands``).
 
-The class is pure: it gets a function that sends commands, and the node's subscriber hands it the
-measured states (:meth:`update`); :meth:`from_params` wires both to the topics the node offers
-(:class:`~thorvald_base.bases.handle.Ports`), so no ROS module is imported here.
+The class is pure: it gets a function that sends commands, and the node's subscribers hand it the
+measured states (:meth:`update`) and motor currents (:meth:`update_currents`, from ``drive_currents``);
+:meth:`from_params` wires them to the topics the node offers (:class:`~thorvald_base.bases.handle.Ports`),
+so no ROS module is imported here.
+
+The motor controllers (``motor_controller_data``) report what a real robot's would: per drive the
+propulsion channel (rim speed, wheel angle, motor amps, relative power) and, for a drive that steers,
+the steering channel (steering speed, angle, amps, relative power), channels in drive order per
+controller, from the newest measurement at or before the instant asked. The relative power is the
+output torque the current carries (:func:`thorvald_model.motors.output_torque`, the drive's motors)
+over the drive's torque limit, within [-1, 1]; before any currents came, amps and power read 0.
 
 A cycle at instant t reads the newest measurement taken at or before t: in lockstep the simulator
 steps on as soon as the cycle's commands reach it, and the next instant's states may arrive while
@@ -23,13 +31,15 @@ Rim speeds cross the topics as the simulator converts them: with the radius of t
 the configuration's ``r_wheel`` when this handle was made (the spawn radius). When set_drive_params
 (or ``~calibration``) changes a drive's ``r_wheel``, the wheel must turn as the new radius says, as a
 CAN controller's would: a rim speed v is sent as v * r_spawn / r_now (the joint turns at v / r_now)
-and a measured one read as v * r_now / r_spawn. Angles (steering, wheel) cross unchanged.
+and a measured one read as v * r_now / r_spawn. Angles (steering, wheel) and currents cross unchanged.
 """
 
 import threading
 from collections import deque
 from dataclasses import replace
 from typing import Callable, Optional, Sequence, Tuple
+
+from thorvald_model.motors import Motor, output_torque, propulsion_motor, steering_motor
 
 from ..errors import ParameterError
 from ..kinematics import DriveCommand
@@ -44,6 +54,7 @@ SAME_INSTANT = 1e-9  # [s]
 class SimulatedJointsBase(BaseHandle):
     COMMAND_TOPIC = "drive_commands"
     STATE_TOPIC = "drive_states"
+    CURRENT_TOPIC = "drive_currents"
     supports_lockstep = True  # wait_for_states and answer: the simulator's instants, one by one
 
     def __init__(self, config, send: Optional[SendCommands] = None, stale_after: float = 0.5):
@@ -53,6 +64,7 @@ class SimulatedJointsBase(BaseHandle):
         self._lock = threading.Lock()
         self._unmeasured = [MeasuredDrive(0.0, 0.0, 0.0, 0.0) for _ in config.drives]  # read before any came
         self._history = deque(maxlen=HISTORY)  # (time, states) of the last measurements, oldest first
+        self._currents = deque(maxlen=HISTORY)  # (time, (prop amps, steer amps)) likewise
         self._topics = None
         self._arrived = threading.Condition(self._lock)  # lockstep: new drive states
         self._last_sent: Optional[Tuple[DriveCommand, ...]] = None  # what went to the simulator last
@@ -62,14 +74,16 @@ class SimulatedJointsBase(BaseHandle):
     @classmethod
     def from_params(cls, config, params, ports=None) -> "SimulatedJointsBase":
         """Wired to the simulator through the node's drive topics (``drive_commands`` out,
-        ``drive_states`` in); ``params.measured_timeout`` [s] is when measurements are stale."""
+        ``drive_states`` and ``drive_currents`` in); ``params.measured_timeout`` [s] is when
+        measurements are stale."""
         if ports is None:
             raise ParameterError("~base_handle: 'simulated_joints': needs base_driver's topics (run it in the node)")
-        topics = ports.drive_topics(cls.COMMAND_TOPIC, cls.STATE_TOPIC)
+        topics = ports.drive_topics(cls.COMMAND_TOPIC, cls.STATE_TOPIC, cls.CURRENT_TOPIC)
         handle = cls(
             config, lambda commands, time: topics.send(commands, time, handle.config.drives), params.measured_timeout
         )
         topics.listen(handle.update)
+        topics.listen_currents(handle.update_currents)
         handle._topics = topics
         return handle
 
@@ -82,6 +96,26 @@ class SimulatedJointsBase(BaseHandle):
                 self._history.clear()  # simulated time went back (a reset)
             self._history.append((time, list(states)))
             self._arrived.notify_all()
+
+    def update_currents(self, prop_amps: Sequence[float], steer_amps: Sequence[float], time: float) -> None:
+        """The simulator's latest motor currents [A] of every drive, in drive order, taken at time [s]:
+        propulsion and steering (0 for a drive that does not steer)."""
+        n = len(self.config.drives)
+        if len(prop_amps) != n or len(steer_amps) != n:
+            raise ValueError(f"{len(prop_amps)} propulsion and {len(steer_amps)} steering currents for {n} drives")
+        with self._lock:
+            if self._currents and time < self._currents[-1][0]:
+                self._currents.clear()  # simulated time went back (a reset)
+            self._currents.append((time, (tuple(prop_amps), tuple(steer_amps))))
+
+    @staticmethod
+    def _at(history, time: float, default):
+        """The newest of history's (time, value) taken at or before time [s]; the newest of all if every
+        one is newer (the clock lags); default if there is none. Under the lock."""
+        return next(
+            (value for t, value in reversed(history) if t <= time + SAME_INSTANT),
+            history[-1][1] if history else default,
+        )
 
     @property
     def _measured_time(self) -> Optional[float]:
@@ -120,12 +154,7 @@ class SimulatedJointsBase(BaseHandle):
 
     def _read_drive_states(self, time):
         with self._lock:
-            # the newest taken at or before time; the newest of all if every one is newer (the clock lags)
-            measured = next(
-                (states for t, states in reversed(self._history) if t <= time + SAME_INSTANT),
-                self._history[-1][1] if self._history else self._unmeasured,
-            )
-            measured = list(measured)
+            measured = list(self._at(self._history, time, self._unmeasured))
         return [replace(m, speed=m.speed * k) if k != 1.0 else m for m, k in zip(measured, self._scales)]
 
     def _home_steering(self):
@@ -136,12 +165,44 @@ class SimulatedJointsBase(BaseHandle):
         self._scales = tuple(d.r_wheel / r for d, r in zip(config.drives, self._spawn_radii))
 
     def controllers(self, time):
+        # One controller per type-0 drive (propulsion + steering channels) and one per pair of type-1
+        # drives (two propulsion channels), as on the robot; channels in the drives' order.
         mode = MODE_ONLINE if self.online(time) else MODE_LOST_CONNECTION
-        return [
-            ControllerInfo(name=c.name, type="simulated joints", version="thorvald_sim", can_id=c.node, mode=mode)
-            for c in self.config.motor_controllers
-        ]
+        drives = self.config.drives
+        states = self._read_drive_states(time)  # the controllers' own angles: no steering offset
+        with self._lock:  # None: no currents came yet
+            prop_amps, steer_amps = self._at(self._currents, time, ((None,) * len(drives),) * 2)
+        out = []
+        for c in self.config.motor_controllers:
+            motor_vars = []
+            for k in c.indices:
+                d, m = drives[k], states[k]
+                # the wheel's turning rate [rad/s]: the rim speed with the radius it was scaled to
+                prop = _channel(prop_amps[k], propulsion_motor(d), m.speed / d.r_wheel, d.max_wheel_torque)
+                motor_vars.append(("propulsion", m.speed, m.wheel_angle, *prop))
+                if c.steered:
+                    steer = _channel(steer_amps[k], steering_motor(d), m.steering_speed, d.max_steering_torque)
+                    motor_vars.append(("steering", m.steering_speed, m.steering, *steer))
+            out.append(
+                ControllerInfo(
+                    name=c.name,
+                    type="simulated joints",
+                    version="thorvald_sim",
+                    can_id=c.node,
+                    mode=mode,
+                    motor_vars=tuple(motor_vars),
+                )
+            )
+        return out
 
     def _close(self):
         if self._topics is not None:
             self._topics.close()
+
+
+def _channel(amps: Optional[float], motor: Motor, rate: float, limit: float) -> Tuple[float, float]:
+    """(amps, relative power) of a motor channel: its current [A] (None: none came yet, both 0), and
+    the output torque it carries at the output's rate [rad/s] over its limit [N m], within [-1, 1]."""
+    if amps is None:
+        return 0.0, 0.0
+    return amps, max(-1.0, min(1.0, output_torque(motor, amps, rate) / limit))

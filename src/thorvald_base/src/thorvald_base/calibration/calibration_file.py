@@ -37,8 +37,14 @@ _KEY_ORDER = {k.name: n for n, k in enumerate(DRIVE_KEYS)}  # the robot file's o
 def calibration_dict(calibration: Calibration, extra: Sequence[Change] = ()) -> Dict[str, Any]:
     """What was estimated, in the robot file's shape (parameters not excited are left out), with
     extra (drive index, key, value) besides, e.g. what an earlier calibration set and this one kept."""
+    return changes_dict([(p.index, p.key, p.value) for p in calibration.estimated], extra)
+
+
+def changes_dict(changes: Sequence[Change], extra: Sequence[Change] = ()) -> Dict[str, Any]:
+    """(drive index, key, value) changes in the robot file's shape, with extra besides (a key the
+    changes set wins over the same key in extra)."""
     # 9 significant digits: far below any uncertainty, and 0.2016 stays 0.2016 in the file
-    values = {(p.index, p.key): float(f"{p.value:.9g}") for p in calibration.estimated}
+    values = {(index, key): float(f"{value:.9g}") for index, key, value in changes}
     for index, key, value in extra:
         values.setdefault((index, key), float(value))
     drives: Dict[str, Dict[str, float]] = {}
@@ -49,8 +55,13 @@ def calibration_dict(calibration: Calibration, extra: Sequence[Change] = ()) -> 
 
 def calibration_yaml(calibration: Calibration, header: str = "", extra: Sequence[Change] = ()) -> str:
     """The file's text: an optional comment header (each line prefixed with '# '), then the values."""
+    return changes_yaml([(p.index, p.key, p.value) for p in calibration.estimated], header, extra)
+
+
+def changes_yaml(changes: Sequence[Change], header: str = "", extra: Sequence[Change] = ()) -> str:
+    """The file's text for (drive index, key, value) changes: as calibration_yaml."""
     comment = "".join(f"# {line}\n" for line in header.splitlines())
-    return comment + yaml.safe_dump(calibration_dict(calibration, extra), sort_keys=False, default_flow_style=False)
+    return comment + yaml.safe_dump(changes_dict(changes, extra), sort_keys=False, default_flow_style=False)
 
 
 def load_calibration(path: str, config: RobotConfig) -> List[Change]:

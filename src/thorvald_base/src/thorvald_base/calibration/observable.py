@@ -120,6 +120,27 @@ class ObservableFit:
         return out
 
 
+def along_undetermined(fit: ObservableFit, values: Sequence[float], radii: Sequence[float]) -> Tuple[float, ...]:
+    """values (of fit.names, e.g. another fit's) moved towards each drive's radius in radii [m] (what
+    the wheels' torques tell: :mod:`.torque_balance`) along the combinations the drive did not determine
+    only: every determined combination keeps values' (what ground truth saw of the odometry stays as it
+    saw it), the rest takes the radii's, with the offsets they are mixed with. In units of the priors,
+    as the combinations are."""
+    unit = np.array([RADIUS_PRIOR if n.endswith("r_wheel") else OFFSET_PRIOR for n in fit.names])
+    delta = np.zeros(len(fit.names))
+    for i, name in enumerate(fit.names):
+        if name.endswith("r_wheel"):
+            k = int(name.split(".")[0][len("drive") :])
+            delta[i] = math.log(radii[k] / values[i]) / RADIUS_PRIOR
+    for c in fit.determined:
+        v = np.asarray(c.vector)
+        delta -= v * float(v @ delta)
+    out = []
+    for name, value, d, u in zip(fit.names, values, delta, unit):
+        out.append(float(value * math.exp(d * u)) if name.endswith("r_wheel") else float(value + d * u))
+    return tuple(out)
+
+
 def observable_fit(
     config: RobotConfig,
     recording: DriveRecording,

@@ -28,9 +28,10 @@ from typing import Any, Dict, List, Mapping
 
 import numpy as np
 
+from thorvald_model.motors import propulsion_motor, steering_motor
 from thorvald_model.schema import Key, one_of
 
-from ..energy import Battery, Motor, energy_use, motor_power
+from ..energy import Battery, energy_use, motor_power
 from ..route import PurePursuit, field_route
 from .driving import SURFACE_RULE, SURFACES, TIPPED, feasible_twist, flat_world
 from .gradeability import SETTLE
@@ -120,12 +121,12 @@ def _powers(config, records, regenerative: bool) -> Dict[str, np.ndarray]:
     """Each motor's electrical power [W] at every record, by the drive's motor model."""
     out: Dict[str, np.ndarray] = {}
     for k, d in enumerate(config.drives):
-        wheel = Motor(d.prp_motor_kt, d.prp_motor_r, d.prp_motor_i0, d.prp_gr_rt, d.prp_gear_eff)
+        wheel = propulsion_motor(d)
         torque = np.array([loads[k].wheel_torque for _, loads in records])
         rate = np.array([loads[k].wheel_rate for _, loads in records])
         out[f"{d.name}.wheel"] = np.asarray(motor_power(wheel, torque, rate, regenerative)[0])
         if d.steerable:
-            steer = Motor(d.str_motor_kt, d.str_motor_r, d.str_motor_i0, d.str_gr_rt, d.str_gear_eff)
+            steer = steering_motor(d)
             torque = np.array([loads[k].steering_torque for _, loads in records])
             rate = np.array([loads[k].steering_rate for _, loads in records])
             out[f"{d.name}.steering"] = np.asarray(motor_power(steer, torque, rate, regenerative)[0])

@@ -1,0 +1,193 @@
+"""The ``balance_wheels`` node: each tyre's rolling radius against the others', from the motors' currents.
+
+On a rigid frame of speed-controlled wheels a tyre larger than base_driver thinks pushes and the others
+brake it (:mod:`thorvald_base.calibration.torque_balance`). This node drives the ``balance`` manoeuvre
+(:func:`thorvald_base.verification.plan_named`: straight legs back and forth at 0.2 m/s, a pause after
+each) as ``verification_drive`` drives its manoeuvres, and in each pause reads the wheels' torques over
+the leg from their motor currents (``motor_controller_data``, through each drive's motor and gear:
+:mod:`thorvald_model.motors`), and sets the radii for the next leg through base_driver's
+``set_drive_params``: first a probe along the fight, then the fit of every leg so far. At the end it
+prints each leg's fight (the rms of the wheels' torques beyond their mean, and the electrical power
+the motors spent on it) and the balanced radii, and writes them (``~out``): the calibration base_driver
+started with (``~calibration``), each r_wheel replaced by its balanced value. The radii keep their
+geometric mean: the common factor is ground truth's to tell (``calibrate_odometry``).
+
+Drive it on level, even ground, with the steering offsets calibrated (a wheel homed off rolls at an
+angle, and its sideways scrub shifts the balance by a few tenths of a percent).
+
+Parameters: verification_drive's (but ``~manoeuvre``: always ``balance``; ``~side`` [m]: each leg's
+length, default 4), ``~calibration`` (the calibration file base_driver runs with, if any),
+``~out`` (the file to write; default none), ``~json`` (a file for the report's figures; default
+none), ``~drive_params_service`` (default ``base_driver/set_drive_params``) and ``~controllers_topic``
+(default ``motor_controller_data``).
+Exit status 0 with the report; 1 when the motors report no current (a base that does not measure
+it) or the wheels' torques do not grow with their slip; 2 for a bad robot or calibration file.
+"""
+
+import json
+import math
+import os
+import sys
+from typing import List, Sequence, Tuple
+
+import numpy as np
+import rospy
+
+from thorvald_model import ConfigError
+from thorvald_model.motors import Motor, output_torque, propulsion_motor
+from thorvald_msgs.msg import ControllerArray, DriveParam
+from thorvald_msgs.srv import DriveParams
+
+from .calibration.calibration_file import changes_yaml, load_calibration
+from .calibration.torque_balance import Leg, fight_power, fit_balance, next_radii
+from .errors import CalibrationError
+from .verification import BALANCE_SPEED, balance_legs
+from .verification_node import VerificationDrive
+
+DECIDE_AFTER = 1.5  # [s] after a leg's end: its last motor_controller_data has arrived (1 Hz)
+MIN_SAMPLES = 3  # motor_controller_data messages a leg must hold
+
+
+class BalanceDrive(VerificationDrive):
+    def __init__(self):
+        super().__init__("balance")
+        self.motors: List[Motor] = [propulsion_motor(d) for d in self.config.drives]
+        path = str(rospy.get_param("~calibration", "") or "")
+        self.calibration = load_calibration(path, self.config) if path else []
+        config = self.config
+        for index, key, value in self.calibration:
+            config = config.with_drive_param(index, key, value)
+        self.radii: Tuple[float, ...] = tuple(d.r_wheel for d in config.drives)
+        self.start_radii = self.radii
+        self.out = str(rospy.get_param("~out", "") or "")
+        self.json = str(rospy.get_param("~json", "") or "")
+        self.windows = balance_legs(self.plan)
+        self.legs: List[Leg] = []
+        self.applied: List[Tuple[float, ...]] = []
+        self.samples: List[Tuple[float, Tuple[float, ...]]] = []  # (stamp, propulsion amps per drive)
+        self.service = rospy.resolve_name(str(rospy.get_param("~drive_params_service", "base_driver/set_drive_params")))
+        rospy.Subscriber(
+            str(rospy.get_param("~controllers_topic", "motor_controller_data")),
+            ControllerArray,
+            self.on_controllers,
+            queue_size=100,
+        )
+
+    def on_controllers(self, msg):
+        by_name = {c.name: c for c in msg.controllers}
+        amps = [math.nan] * len(self.config.drives)
+        for controller in self.config.motor_controllers:
+            c = by_name.get(controller.name)
+            if c is None:
+                continue
+            propulsion = [v for v in c.motor_vars if v.type == "propulsion"]
+            for index, var in zip(controller.indices, propulsion):
+                amps[index] = var.motor_amps
+        self.samples.append((msg.header.stamp.to_sec(), tuple(amps)))
+
+    def during(self, start: float, t: float) -> None:
+        while len(self.legs) < len(self.windows) and t >= self.windows[len(self.legs)][1] + DECIDE_AFTER:
+            self.legs.append(self.measure(start, *self.windows[len(self.legs)]))
+            if len(self.legs) < len(self.windows):
+                self.apply(next_radii(self.legs))
+
+    def measure(self, start: float, begin: float, end: float, speed: float) -> Leg:
+        """The leg's mean wheel torques over its measured part, from the currents reported in it."""
+        rows = [amps for stamp, amps in self.samples if start + begin <= stamp <= start + end]
+        rows = [amps for amps in rows if all(math.isfinite(a) for a in amps)]
+        if len(rows) < MIN_SAMPLES:
+            raise RuntimeError(
+                f"{len(rows)} motor_controller_data messages with every drive's current during balance leg "
+                f"{len(self.legs) + 1} ({begin:.0f} to {end:.0f} s): is base_driver publishing them?"
+            )
+        rates = [speed / r for r in self.radii]
+        torques = np.mean(
+            [[output_torque(m, a, w) for m, a, w in zip(self.motors, amps, rates)] for amps in rows], axis=0
+        )
+        if not np.any(np.abs(np.mean(rows, axis=0)) > 0.0):
+            raise RuntimeError("every motor current reads 0: this base does not measure its motors' currents")
+        return Leg(self.radii, speed, tuple(float(t) for t in torques), tuple(rates), end - begin, len(rows))
+
+    def apply(self, radii: Sequence[float]) -> None:
+        try:
+            rospy.wait_for_service(self.service, timeout=self.startup_timeout)
+            params = [DriveParam(index=k, type="r_wheel", value=float(r)) for k, r in enumerate(radii)]
+            answer = rospy.ServiceProxy(self.service, DriveParams)(params)
+        except (rospy.ROSException, rospy.ServiceException) as e:
+            raise RuntimeError(f"{self.service}: {e}") from None
+        if answer.status < len(radii):
+            raise RuntimeError(f"{self.service} refused the radii: {answer.message}")
+        self.radii = tuple(float(r) for r in radii)
+        self.applied.append(self.radii)
+
+    def balance(self) -> str:
+        """Drives the legs; the report, having written ~out."""
+        self.run()
+        if len(self.legs) < len(self.windows):
+            raise RuntimeError(f"the drive ended after {len(self.legs)} of {len(self.windows)} legs")
+        fit = fit_balance(self.legs)
+        text = report(self.name, self.legs, fit, self.start_radii, self.motors, description=self.description)
+        if self.out:
+            changes = [(k, "r_wheel", r) for k, r in enumerate(fit.radii)]
+            header = (
+                f"balance_wheels: {self.name}, each tyre's radius against the others' from its motor's current;\n"
+                "the other values as the calibration it started with"
+            )
+            with open(self.out, "w") as f:
+                f.write(changes_yaml(changes, header, extra=self.calibration))
+            text += f"\nwrote {os.path.abspath(self.out)}"
+        if self.json:
+            with open(self.json, "w") as f:
+                json.dump(as_json(self.legs, fit, self.start_radii, self.motors), f, indent=2)
+        return text
+
+
+def report(name, legs: Sequence[Leg], fit, start: Sequence[float], motors: Sequence[Motor], *, description: str) -> str:
+    """The legs' fight, then each drive's radius before and balanced."""
+    lines = [f"balance_wheels: {name}: {description}", "", "leg  way        fight [N m]  fight [W]"]
+    for k, leg in enumerate(legs):
+        way = "forwards" if leg.speed > 0 else "back"
+        lines.append(f"{k + 1:<4} {way:<10} {leg.fight:>11.2f}  {max(fight_power(leg, motors), 0.0):>9.1f}")
+    lines += ["", "drive    r_wheel [m]   balanced [m]   change [%]   +- [%]"]
+    for k, (before, after, sd) in enumerate(zip(start, fit.radii, fit.sd)):
+        change, spread = 100 * (after / before - 1), 100 * sd / after
+        lines.append(f"drive{k:<3} {before:>11.5f}   {after:>12.5f}   {change:>+10.3f}   {spread:>6.3f}")
+    first, last = legs[0], legs[-1]
+    lines += [
+        "",
+        f"slip stiffness {fit.stiffness:.0f} N m s/m (the wheels' mean), torques fitted to {fit.residual:.2f} N m rms",
+        f"the wheels spent {max(fight_power(first, motors), 0.0):.1f} W against each other at {BALANCE_SPEED:g} m/s "
+        f"on the first leg, {max(fight_power(last, motors), 0.0):.1f} W on the last",
+    ]
+    return "\n".join(lines)
+
+
+def as_json(legs: Sequence[Leg], fit, start: Sequence[float], motors: Sequence[Motor]) -> dict:
+    """The report's figures."""
+    return {
+        "legs": [
+            {"speed": leg.speed, "fight_nm": leg.fight, "fight_w": max(fight_power(leg, motors), 0.0),
+             "torques_nm": list(leg.torques), "samples": leg.samples}
+            for leg in legs
+        ],
+        "stiffness": fit.stiffness,
+        "residual_nm": fit.residual,
+        "drives": {
+            f"drive{k}": {"r_wheel_before": before, "r_wheel": after, "sd": sd}
+            for k, (before, after, sd) in enumerate(zip(start, fit.radii, fit.sd))
+        },
+    }  # fmt: skip
+
+
+def main():
+    rospy.init_node("balance_wheels")
+    try:
+        text = BalanceDrive().balance()
+    except ConfigError as e:
+        rospy.logfatal("balance_wheels: %s", e)
+        sys.exit(2)
+    except (RuntimeError, KeyError, CalibrationError) as e:
+        rospy.logfatal("balance_wheels: %s", e)
+        sys.exit(1)
+    print(text, flush=True)
+    rospy.signal_shutdown("balance drive done")
