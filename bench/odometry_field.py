@@ -9,8 +9,8 @@ contributes, against RTK-GNSS as the paper measured and against the simulator's 
    Target: the paper's range over five seeds, distance error 0.5 to 2 % and end point 1 to 4 m.
 2. Ablation, on one seed's draw: the ideal robot on flat ground; each imperfection of that draw alone
    on flat ground (each tyre's own radius, the load's common radius, the steering offsets, the
-   encoders' counts); the ideal robot on tarmac_gravel (the terrain alone); and everything on
-   tarmac_gravel.
+   encoders' counts, the tyres' softness, and each tyre's own radius on soft tyres); the ideal robot
+   on tarmac_gravel (the terrain alone); and everything on tarmac_gravel.
 
 Each run is a simulation of about 90 s, as fast as the machine can (about 30 s of wall time here),
 in lockstep: a seed gives the same figures on every run. Exit status 1 when the target is missed.
@@ -53,9 +53,12 @@ def lsq(figures: dict, against: str = "against_rtk_gnss") -> dict:
 def only(built, what: str) -> dict:
     """An as-built file's contents keeping one kind of imperfection of a draw: ``radius`` (each tyre's
     own, without the load), ``loaded`` (the load's common radius, every tyre alike), ``steering``,
-    ``encoders``."""
+    ``encoders``, ``tyres`` (soft: their deflection under the load), ``radius+tyres``; rigid tyres but
+    for the last two."""
     data = {"encoders": what == "encoders"}
-    if what == "radius":
+    if what in ("tyres", "radius+tyres"):
+        data["tyre_deflection"] = built.tyre_deflection
+    if what in ("radius", "radius+tyres"):
         data["motor_drives"] = {d.name: {"r_wheel": d.r_wheel / (1.0 - built.loaded)} for d in built.drives}
     elif what == "loaded":
         data["motor_drives"] = {
@@ -100,7 +103,7 @@ def main() -> int:
     print(f"2. ablation, field:{args.ablation_seed}'s imperfections one at a time (odometry lsq against RTK-GNSS)")
     print(f"{'case':>38} {'error':>8} {'end point':>10} {'heading':>9}")
     cases = [("ideal robot, flat ground", "", "flat")]
-    for what in ("radius", "loaded", "steering", "encoders"):
+    for what in ("radius", "loaded", "steering", "encoders", "tyres", "radius+tyres"):
         path = os.path.join(work, f"only_{what}.yaml")
         with open(path, "w") as f:
             yaml.safe_dump(only(built, what), f)

@@ -166,19 +166,18 @@ def test_the_same_seed_in_lockstep_gives_the_same_report_with_both_cores_busy(de
             assert getattr(pa, field)[:n] == getattr(pb, field)[:n], (name, field)
 
 
-def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determines(tmp_path):
-    """calibration_drive: the paper's six-wheeled robot as built (field:3) through the calibration
-    manoeuvre in the simulator, recorded whole, calibrated from it: the drive determines 7 of its 12
-    combinations, and its own odometry after the calibration is closer to ground truth. Then its
-    wheels balanced from their motor currents: they stop fighting, and each tyre's radius against the
-    others' comes within the issue's 0.3 % of the as-built robot's, where ground truth left it 0.9 % off."""
-    proc = run(
-        ["rosrun", "thorvald_bringup", "calibration_drive", "--as-built", "field:3", "--out", str(tmp_path), "--json"],
-        timeout=900,
-    )
-    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
-    result = json.loads(proc.stdout[proc.stdout.index("{") :])
-    assert "calibration manoeuvre" in proc.stdout and "balance manoeuvre" in proc.stdout
+def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determines(demo):
+    """calibration_drive, as the main job ran it: the paper's six-wheeled robot as built (field:3)
+    through the calibration manoeuvre in the simulator, recorded whole, calibrated from it: the drive
+    determines 7 of its 12 combinations, and its own odometry after the calibration is closer to ground
+    truth. Then its wheels balanced from their motor currents: they stop fighting, and each tyre's
+    radius against the others' comes within the issue's 0.3 % of the as-built robot's, where ground
+    truth left it 0.9 % off."""
+    out = os.path.join(WS, "build", "calibration_drive")
+    with open(os.path.join(out, "result.json")) as f:
+        text = f.read()
+    result = json.loads(text[text.index("{") :])
+    assert "calibration manoeuvre" in text and "balance manoeuvre" in text
     assert sum(c["determined"] for c in result["combinations"]) == 7 and len(result["combinations"]) == 12
     before, after = result["before"], result["after"]
     assert before["end_point_m"] > 1.0 and abs(before["distance_error_percent"]) > 1.0  # tyres 2 % small
@@ -194,7 +193,8 @@ def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determi
     assert tyres["ground_truth"]["largest_relative_percent"] > 0.6
     assert tyres["balanced"]["largest_relative_percent"] < 0.3
     for name in ("calibration.yaml", "odometry_calibration.yaml", "balanced.yaml", "calibration_drive.bag"):
-        assert (tmp_path / name).is_file(), name
+        assert os.path.isfile(os.path.join(out, name)), name
+    assert "field:3 on the field route against RTK-GNSS: uncalibrated" in demo
 
 
 def test_verification_drive_on_base_drivers_own_simulated_drives():

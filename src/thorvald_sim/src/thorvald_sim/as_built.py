@@ -63,7 +63,12 @@ DRIVE_KEYS = (
 ENCODERS_KEY = Key("encoders", bool, False)
 DELAY_KEY = Key("delay", float, 0.0, check=lambda v: 0 <= v <= MAX_DELAY, rule=f"must be in [0, {MAX_DELAY}] s")
 MASS_OFFSET_KEY = Key("mass_offset", float, 0.0, check=non_negative, rule="must be >= 0 (a load)")
-TOP_KEYS = ("motor_drives", "encoders", "delay", "mass_offset")
+MAX_TYRE_DEFLECTION = 0.1  # [m]
+TYRE_KEY = Key(
+    "tyre_deflection", float, 0.0, check=lambda v: 0 <= v <= MAX_TYRE_DEFLECTION,
+    rule=f"must be in [0, {MAX_TYRE_DEFLECTION}] m (0: rigid tyres)",
+)  # fmt: skip
+TOP_KEYS = ("motor_drives", "encoders", "delay", "mass_offset", "tyre_deflection")
 
 
 @dataclass(frozen=True)
@@ -110,6 +115,7 @@ class AsBuilt:
     mass_offset: float  # [kg]
     configured: Tuple[float, ...]  # [m] each drive's r_wheel in the configuration
     loaded: float = 0.0  # [-] a profile's draw: every tyre's radius this much below its own draw (included in r_wheel)
+    tyre_deflection: float = 0.0  # [m] each tyre's under its share of the weight (soft tyres); 0: rigid
 
     def drive(self, name: str) -> DriveAsBuilt:
         for d in self.drives:
@@ -120,7 +126,13 @@ class AsBuilt:
     @property
     def ideal(self) -> bool:
         """Built exactly to the configuration."""
-        return not self.encoders and self.delay == 0 and self.mass_offset == 0 and not self.differences()
+        return (
+            not self.encoders
+            and self.delay == 0
+            and self.mass_offset == 0
+            and self.tyre_deflection == 0
+            and not self.differences()
+        )
 
     def differences(self) -> Dict[str, Dict[str, float]]:
         """The drives that differ from the configuration: {driveN: {key: value}} (for reports)."""
@@ -150,6 +162,7 @@ def parse_as_built(data: Any, config: RobotConfig, source: str = "<as-built>") -
     encoders = parse_scalar(data, ENCODERS_KEY, problems)
     delay = parse_scalar(data, DELAY_KEY, problems)
     mass_offset = parse_scalar(data, MASS_OFFSET_KEY, problems)
+    deflection = parse_scalar(data, TYRE_KEY, problems)
     given = _drive_entries(data.get("motor_drives"), config, problems)
     drives = []
     for i, d in enumerate(config.drives):
@@ -170,7 +183,7 @@ def parse_as_built(data: Any, config: RobotConfig, source: str = "<as-built>") -
         drives.append(DriveAsBuilt(name, radius, offset))
     if problems:
         raise ConfigError(source, problems, WHAT)
-    return AsBuilt(source, tuple(drives), encoders, delay, mass_offset, _radii(config))
+    return AsBuilt(source, tuple(drives), encoders, delay, mass_offset, _radii(config), tyre_deflection=deflection)
 
 
 def load_as_built(path: str, config: RobotConfig) -> AsBuilt:
@@ -216,7 +229,8 @@ def draw_as_built(spec: str, config: RobotConfig) -> AsBuilt:
         DriveAsBuilt(_name(i), d.r_wheel * scale * (1.0 - loaded), offset)
         for i, (d, (scale, offset)) in enumerate(zip(config.drives, draws))
     )
-    return AsBuilt(spec, drives, profile.encoders, 0.0, 0.0, _radii(config), loaded)
+    deflection = TYRE_DEFLECTION_PER_LOADED * loaded * sum(d.r_wheel for d in config.drives) / len(config.drives)
+    return AsBuilt(spec, drives, profile.encoders, 0.0, 0.0, _radii(config), loaded, deflection)
 
 
 def as_built_for(spec: str, config: RobotConfig) -> AsBuilt:
@@ -332,8 +346,7 @@ def for_simulator(as_built: AsBuilt, config: RobotConfig) -> SimAsBuilt:
                 "steering_rate_step": scaling.steering_rate(1.0) if drive.steerable else 0.0,
             }
         drives.append(BuiltDrive(built.r_wheel, built.steering_offset, **counts))
-    deflection = TYRE_DEFLECTION_PER_LOADED * as_built.loaded * sum(as_built.configured) / len(as_built.configured)
-    return SimAsBuilt(as_built.source, tuple(drives), as_built.delay, as_built.mass_offset, deflection)
+    return SimAsBuilt(as_built.source, tuple(drives), as_built.delay, as_built.mass_offset, as_built.tyre_deflection)
 
 
 def describe_as_built(built: AsBuilt) -> str:
@@ -350,6 +363,8 @@ def describe_as_built(built: AsBuilt) -> str:
         extras.append(f"delay {built.delay * 1000:g} ms")
     if built.mass_offset:
         extras.append(f"load {built.mass_offset:g} kg")
+    if built.tyre_deflection:
+        extras.append(f"soft tyres ({built.tyre_deflection * 1000:.1f} mm under their share of the weight)")
     return ", ".join(drives + extras)
 
 

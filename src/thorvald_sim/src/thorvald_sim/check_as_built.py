@@ -46,6 +46,7 @@ def summary(built: AsBuilt, sim: SimAsBuilt, config: RobotConfig) -> dict:
         "delay": built.delay,
         "mass_offset": built.mass_offset,
         "loaded": built.loaded,
+        "tyre_deflection": built.tyre_deflection,
         "drives": drives,
     }
 
@@ -61,6 +62,8 @@ def format_details(s: dict) -> str:
     ]
     if s["loaded"]:
         lines.append(f"  tyres     loaded {-s['loaded'] * 100:+.2f} % (included in every r below)")
+    if s["tyre_deflection"]:
+        lines.append(f"  tyres     soft: {s['tyre_deflection'] * 1000:.1f} mm under their share of the weight")
     lines += [
         "",
         "  drive      r [m]  configured [m]  difference [mm]    [%]  steering offset [deg]"

@@ -1,0 +1,60 @@
+"""An as-built robot's soft tyres (thorvald_sim.as_built ``tyre_deflection``, the field profile's loaded
+tyres): a frame of more than three wheels stands on all of them, as it does on pneumatic tyres, where
+rigid tyres of radii a millimetre apart left it on two."""
+
+import pytest
+
+from thorvald_model import ConfigError, load_robot_config
+from thorvald_model.description import package_file
+from thorvald_sim.as_built import SimAsBuilt, as_built_for, draw_as_built, parse_as_built
+from thorvald_sim.runner import RobotSession, RunOptions
+
+ASYM = package_file("config", "thorvald_ii_6wd6ws_asym", "thorvald_ii_6wd6ws_asym.yaml")
+
+
+def loads(as_built: str):
+    with RobotSession(ASYM, RunOptions(as_built=as_built)) as s:
+        s.run(2.0, lambda t: (0.0, 0.0, 0.0))
+        return s.robot.wheel_loads(), s.robot.world_pose()[0][2]
+
+
+def rigid_copy(tmp_path, spec: str) -> str:
+    """The profile's draw as a file, its tyres rigid."""
+    built = as_built_for(spec, load_robot_config(ASYM))
+    lines = ["tyre_deflection: 0.0", "encoders: true", "motor_drives:"]
+    lines += [f"  {d.name}: {{r_wheel: {d.r_wheel!r}, steering_offset: {d.steering_offset!r}}}" for d in built.drives]
+    path = tmp_path / "rigid.yaml"
+    path.write_text("\n".join(lines) + "\n")
+    return str(path)
+
+
+def test_the_field_profiles_tyres_give_three_times_their_radius_drop():
+    config = load_robot_config(ASYM)
+    built = draw_as_built("field:3", config)
+    assert built.tyre_deflection == pytest.approx(3.0 * built.loaded * 0.2)
+    assert 0.006 <= built.tyre_deflection <= 0.012  # 1 to 2 % of 0.2 m, three times
+    assert not built.ideal
+
+
+def test_on_soft_tyres_every_wheel_carries_load_on_rigid_ones_two_carry_the_robot(tmp_path):
+    soft, z_soft = loads("field:3")
+    rigid, z_rigid = loads(rigid_copy(tmp_path, "field:3"))
+    assert sum(soft) == pytest.approx(sum(rigid), rel=0.01)  # the robot's weight either way
+    assert min(soft) > 0.04 * sum(soft)  # every one of six wheels carries its part (131 to 754 N measured)
+    assert sorted(rigid)[3] < 1.0  # four wheels in the air, or nearly (the two largest tyres carry it)
+    assert z_soft < z_rigid - 0.003  # the frame sits lower on the tyres' deflection
+
+
+def test_the_as_built_file_takes_a_tyre_deflection_checked():
+    config = load_robot_config(ASYM)
+    assert parse_as_built({"tyre_deflection": 0.01}, config).tyre_deflection == 0.01
+    assert parse_as_built({}, config).tyre_deflection == 0.0
+    with pytest.raises(ConfigError, match=r"tyre_deflection: -0.01: must be in \[0, 0.1\] m"):
+        parse_as_built({"tyre_deflection": -0.01}, config, "f.yaml")
+
+
+def test_the_spawn_request_carries_the_tyres_and_reads_one_without_them():
+    built = SimAsBuilt("x", (), 0.0, 0.0, 0.011)
+    assert SimAsBuilt.from_json(built.to_json()).tyre_deflection == 0.011
+    old = '{"source": "x", "drives": [], "delay": 0.0, "mass_offset": 0.0}'  # from a simulator before them
+    assert SimAsBuilt.from_json(old).tyre_deflection == 0.0
