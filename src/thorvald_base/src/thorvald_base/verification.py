@@ -130,9 +130,7 @@ def _calibration_axle(axle, side: float, drives) -> List[Segment]:
     along its rolling direction, UMBmark's squares both ways with corners turned about a point of
     its axle line CORNER to the side, and circles both ways about such points (a turn slowed where
     its outer wheel would pass TURN_SHARE of its speed limit)."""
-    dx, dy = axle.dx, axle.dy
-    if dy < 0 or (dy == 0 and dx < 0):  # d points to the robot's left
-        dx, dy = -dx, -dy
+    dx, dy = _leftwards(axle)
     nx, ny = dy, -dx
     straight, back = Twist(SPEED * nx, SPEED * ny, 0.0), Twist(-SPEED * nx, -SPEED * ny, 0.0)
     foot = -(axle.x * dx + axle.y * dy)  # from the axle point to the foot of base_link's perpendicular
@@ -156,10 +154,15 @@ def _rolling_direction(config: RobotConfig) -> Tuple[float, float]:
     axle, _ = common_axle(config.drives, config.passive_wheels)
     if axle is None:
         return 1.0, 0.0
-    dx, dy = axle.dx, axle.dy
-    if dy < 0 or (dy == 0 and dx < 0):
-        dx, dy = -dx, -dy
+    dx, dy = _leftwards(axle)
     return dy, -dx
+
+
+def _leftwards(axle) -> Tuple[float, float]:
+    """The axle's unit direction (dx, dy) pointing to the robot's left (for an axle along x: to +x);
+    the rolling direction is then (dy, -dx)."""
+    dx, dy = axle.dx, axle.dy
+    return (-dx, -dy) if dy < 0 or (dy == 0 and dx < 0) else (dx, dy)
 
 
 def _balance(config: RobotConfig, side: float) -> List[Segment]:
@@ -199,9 +202,7 @@ def _field_route(config: RobotConfig) -> List[Segment]:
     if axle is None:
         dx, dy, ax, ay = 0.0, 1.0, 0.0, 0.0  # turn about (0, +-spacing/2), straight along +x
     else:
-        dx, dy, ax, ay = axle.dx, axle.dy, axle.x, axle.y
-        if dy < 0 or (dy == 0 and dx < 0):
-            dx, dy = -dx, -dy
+        (dx, dy), ax, ay = _leftwards(axle), axle.x, axle.y
     nx, ny = dy, -dx
     foot = -(ax * dx + ay * dy)
     straight = Twist(SPEED * nx, SPEED * ny, 0.0)
@@ -233,9 +234,7 @@ def _omnidirectional() -> List[Segment]:
 def _stadium(axle) -> List[Segment]:
     # Straight along the wheels' rolling direction n (perpendicular to the axle direction d); turn
     # about a centre of rotation on the axle line, 3 m to the left of the axle point.
-    dx, dy = axle.dx, axle.dy
-    if dy < 0 or (dy == 0 and dx < 0):  # let d point to the robot's left
-        dx, dy = -dx, -dy
+    dx, dy = _leftwards(axle)
     nx, ny = dy, -dx
     straight = Twist(SPEED * nx, SPEED * ny, 0.0)
     t = -(axle.x * dx + axle.y * dy)  # foot of the perpendicular from base_link's origin
