@@ -39,9 +39,11 @@ from .calibration import (
     ObservableFit,
     OdometryError,
     PoseTruth,
+    ScaleFit,
     as_read_with,
     calibrate,
     calibration_yaml,
+    common_scale,
     load_calibration,
     local_metres,
     observable_fit,
@@ -165,11 +167,12 @@ def parse_args(argv: Optional[List[str]]):
     )
     parser.add_argument(
         "--fit",
-        choices=("drives", "odometry"),
+        choices=("drives", "odometry", "scale"),
         default="drives",
         help="drives: each drive's radius and offset from its own wheel's motion (the default); odometry: only "
         "the combinations the drive determines through the odometry, the rest kept at the values in effect "
-        "(the simulator's ground truth)",
+        "(the simulator's ground truth); scale: only the radii's common factor, from straight legs between "
+        "standstills (the straight manoeuvre, driven with the calibration in effect)",
     )
     parser.add_argument(
         "--balance",
@@ -201,8 +204,14 @@ def run(args) -> int:
         earlier = load_calibration(args.calibration, robot)
         for index, key, value in earlier:
             in_effect = in_effect.with_drive_param(index, key, value)
+    if args.fit == "scale" and args.balance:
+        raise CalibrationError("--balance goes with --fit drives or odometry: --fit scale keeps every radius's share")
     recording, truth, said, namespace = read_bag(args.bag, len(robot.drives), args.ground_truth, args.antenna)
-    if args.fit == "odometry":
+    scale = None
+    if args.fit == "scale":
+        scale = common_scale(in_effect, recording, truth)
+        calibration, observable = scale.calibration(in_effect), None
+    elif args.fit == "odometry":
         if not isinstance(truth, PoseTruth):
             raise CalibrationError(
                 "--fit odometry: needs the simulator's ground truth (a body twist at every instant), not GNSS"
@@ -230,6 +239,7 @@ def run(args) -> int:
         kept,
         observable,
         args.fit,
+        scale,
     )
     if args.json:
         print(json.dumps(as_json(outcome), indent=2))
@@ -272,6 +282,7 @@ class Outcome:
     kept: bool  # the file keeps values of the calibration in effect that were not estimated again
     observable: Optional[ObservableFit] = None  # what the drive determines through the odometry (simulator)
     fit: str = "drives"
+    scale: Optional[ScaleFit] = None  # --fit scale's legs
 
 
 def write_file(path: str, calibration: Calibration, earlier, args, said: str) -> bool:
@@ -316,6 +327,15 @@ def as_json(outcome: Outcome) -> dict:
     if calibration.heading_bias is not None:
         out["imu_yaw_bias"] = {"value": calibration.heading_bias[0], "sd": _number(calibration.heading_bias[1])}
     out["fit"] = outcome.fit
+    if outcome.scale is not None:
+        out["scale"] = {
+            "factor": outcome.scale.factor,
+            "sd": _number(outcome.scale.sd),
+            "legs": [
+                {"truth_m": leg.truth_m, "odometry_m": leg.odometry_m, "path_m": leg.path_m, "straight": leg.straight}
+                for leg in outcome.scale.legs
+            ],
+        }
     if outcome.observable is not None:
         out["combinations"] = [
             {
@@ -345,7 +365,19 @@ def _number(value: float) -> Optional[float]:
 def print_text(outcome: Outcome) -> None:
     calibration, before, after = outcome.calibration, outcome.before, outcome.after
     unit = "windows" if calibration.ground_truth == GNSS else "samples"
+    scale = outcome.scale
+    if scale is not None:
+        unit = "straight legs between standstills"
     print(f"ground truth: {outcome.ground_truth}; {calibration.observations} {unit}")
+    if scale is not None:
+        used = scale.used
+        left = len(scale.legs) - len(used)
+        print(
+            f"the radii's common factor: {scale.factor:.5f} ± {scale.sd:.5f} "
+            f"({100 * (scale.factor - 1):+.3f} %), ground truth's {sum(leg.truth_m for leg in used):.2f} m against "
+            f"odometry's {sum(leg.odometry_m for leg in used):.2f} m"
+            + (f"; {left} legs left out (turned or short)" if left else "")
+        )
     print(f"{'drive':<8} {'r_wheel [m]':<34} steering_offset [rad]")
     rows: Dict[str, Dict[str, str]] = {}
     for p in calibration.parameters:
@@ -355,14 +387,14 @@ def print_text(outcome: Outcome) -> None:
                 text += f" ({math.degrees(p.value):+.3f} deg)"
             text += f" (was {p.in_effect:g})"
         else:
-            text = f"{p.in_effect:g} (not excited)"
+            text = f"{p.in_effect:g} ({'kept' if scale is not None else 'not excited'})"
         rows.setdefault(p.drive, {})[p.key] = text
     for drive, row in rows.items():
         print(f"{drive:<8} {row.get('r_wheel', ''):<34} {row.get('steering_offset', '-')}")
     if calibration.heading_bias is not None:
         value, sd = calibration.heading_bias
         print(f"IMU yaw bias against east: {value:+.5f} ± {sd:.5f} rad ({math.degrees(value):+.3f} deg)")
-    for p in calibration.not_excited:
+    for p in calibration.not_excited if scale is None else ():
         print(f"not excited: {p.drive} {p.key} (left at {p.in_effect:g}): {p.reason}")
     fit = outcome.observable
     if fit is not None:

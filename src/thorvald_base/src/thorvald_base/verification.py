@@ -37,7 +37,7 @@ def plan_for(config: RobotConfig) -> Tuple[str, List[Segment]]:
     return "a stadium twice: straights and half circles about its axle line", _stadium(axle)
 
 
-MANOEUVRES = ("verification", "calibration", "field", "balance")
+MANOEUVRES = ("verification", "calibration", "field", "balance", "straight")
 ROWS, ROW_LENGTH, ROW_SPACING = 5, 15.0, 1.5  # the field route: every second row of 0.75 m rows
 SIDE = 4.0  # [m] of the calibration drive's square (UMBmark's 4 m)
 CORNER = 1.0  # [m] a fixed-axle robot's corner radius on the calibration drive (about a point of its axle line)
@@ -49,6 +49,9 @@ BALANCE_LEGS = 8
 BALANCE_SETTLE = 3.0  # [s] from a leg's start: the robot at speed and the fight steady
 BALANCE_PAUSE = 3.0  # [s]
 BALANCE_LEG = "balance leg"  # the label every leg starts with
+# the straight drive (calibrate_odometry --fit scale): legs along the rolling direction at SPEED, as rows
+# are driven, with standstills between them long enough to average ground truth's position over
+STRAIGHT_PAUSE = 2.0  # [s]
 
 
 def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str, List[Segment]]:
@@ -61,7 +64,7 @@ def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str,
             f"a field route: {ROWS} rows of {ROW_LENGTH:g} m, {ROW_SPACING:g} m apart, joined by headland U turns",
             _field_route(config),
         )
-    if name not in ("calibration", "balance"):
+    if name not in ("calibration", "balance", "straight"):
         raise ValueError(f"manoeuvre must be one of {', '.join(MANOEUVRES)}, not {name!r}")
     if not (side > 0.0 and math.isfinite(side)):
         raise ValueError(f"side must be a positive length [m], not {side!r}")
@@ -70,6 +73,12 @@ def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str,
             f"balancing the wheels: {BALANCE_LEGS} straight legs of {side:g} m back and forth at "
             f"{BALANCE_SPEED:g} m/s, the radii changed between them",
             _balance(config, side),
+        )
+    if name == "straight":
+        return (
+            f"straight legs: {side:g} m out, {2 * side:g} m back and forth three times, {side:g} m back to the start, "
+            f"at {SPEED:g} m/s with {STRAIGHT_PAUSE:g} s stops between them",
+            _straight(config, side),
         )
     axle, _ = common_axle(config.drives, config.passive_wheels)
     if axle is None:
@@ -177,6 +186,22 @@ def _balance(config: RobotConfig, side: float) -> List[Segment]:
         way = "forwards" if sign > 0 else "back"
         legs.append(Segment(twist, side / BALANCE_SPEED, f"{BALANCE_LEG} {k + 1}, {side:g} m {way}"))
         legs.append(Segment(Twist(), BALANCE_PAUSE, "pause: the radii for the next leg"))
+    return legs
+
+
+def _straight(config: RobotConfig, side: float) -> List[Segment]:
+    """Legs along the rolling direction at SPEED, stopping STRAIGHT_PAUSE between them (the first
+    one too, before it): side out, then 2 side back and forth three times, then side back, so the
+    drive stays within side of the start along one line and ends there (8 side in all)."""
+    nx, ny = _rolling_direction(config)
+    lengths = [side, -2.0 * side, 2.0 * side, -2.0 * side, side]
+    legs = [Segment(Twist(), STRAIGHT_PAUSE, "stop")]
+    for k, length in enumerate(lengths):
+        sign = 1.0 if length > 0 else -1.0
+        twist = Twist(sign * SPEED * nx, sign * SPEED * ny, 0.0)
+        way = "forwards" if sign > 0 else "back"
+        legs.append(Segment(twist, abs(length) / SPEED, f"straight leg {k + 1}, {abs(length):g} m {way}"))
+        legs.append(Segment(Twist(), STRAIGHT_PAUSE, "stop"))
     return legs
 
 

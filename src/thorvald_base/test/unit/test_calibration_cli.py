@@ -5,6 +5,7 @@ calibration file; and every way it refuses, one line and exit status 2."""
 import json
 import math
 import os
+import re
 import subprocess
 
 import genpy
@@ -179,6 +180,40 @@ def test_a_calibration_in_effect_is_where_it_starts_and_what_it_keeps(tmp_path, 
     assert (2, "steering_offset", 0.01) in written  # kept from the calibration in effect
     assert [v for i, k, v in written if (i, k) == (1, "r_wheel")] == [pytest.approx(RADII[1], rel=1e-4)]
     assert "kept from" in (tmp_path / "calibration.yaml").read_text()
+
+
+def test_fit_scale_takes_the_radii_common_factor_from_straight_legs_over_the_calibration_in_effect(
+    tmp_path, capsys, std
+):
+    from thorvald_base.verification import plan_named  # noqa: PLC0415
+
+    earlier = tmp_path / "earlier.yaml"
+    earlier.write_text("motor_drives:\n  drive1: {r_wheel: 0.205, steering_offset: 0.01}\n")
+    in_effect = std.with_drive_param(1, "r_wheel", 0.205).with_drive_param(1, "steering_offset", 0.01)
+    truth = [d.r_wheel * 1.003 for d in in_effect.drives]  # every tyre 0.3 % larger than in effect
+    offsets = [d.steering_offset for d in in_effect.drives]
+    plan = [(s.duration, s.twist) for s in plan_named("straight", std, side=3.0)[1]]
+    bag = write_bag(tmp_path / "straight.bag", synthetic_drive(in_effect, plan, truth, offsets))
+    status, out, err = run(capsys, bag, "--robot-model", STD, "--calibration", earlier, "--fit", "scale")
+    assert status == 0, err
+    assert "5 straight legs between standstills" in out
+    assert "the radii's common factor: 1.00300 ± 0.00000 (+0.300 %), ground truth's 24.00 m against" in out
+    assert "not excited" not in out and out.count("(kept)") == 4
+    assert re.search(r"before -0\.299 % of 24\.00 m, end point 0\.000 m; after [+-]0\.000 %", out), out
+    written = dict(((i, k), v) for i, k, v in load_calibration(str(tmp_path / "calibration.yaml"), std))
+    assert written[(1, "steering_offset")] == 0.01  # kept from the calibration in effect
+    assert [written[(i, "r_wheel")] for i in range(4)] == [pytest.approx(r, rel=1e-9) for r in truth]
+    # without --calibration the factor is the same (the bag holds rim speeds) but applies to the file's radii
+    status, out, err = run(capsys, bag, "--robot-model", STD, "--fit", "scale", "--json")
+    assert status == 0, err
+    result = json.loads(out)
+    assert result["scale"]["factor"] == pytest.approx(1.003, rel=1e-9) and len(result["scale"]["legs"]) == 5
+    assert result["drives"]["drive1"]["r_wheel"] == pytest.approx(0.2 * 1.003, rel=1e-9)
+    # a drive of turns has no straight leg; --balance is for the other fits
+    turning = write_bag(tmp_path / "mixed.bag", synthetic_drive(std, MIXED, RADII, OFFSETS))
+    for extra, message in (([], "no straight leg"), (["--balance", earlier], "--balance goes with")):
+        status, out, err = run(capsys, turning, "--robot-model", STD, "--fit", "scale", *extra)
+        assert status == 2 and err.count("\n") == 1 and message in err, err
 
 
 BAD_BAGS = [

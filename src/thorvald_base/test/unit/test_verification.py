@@ -15,6 +15,8 @@ from thorvald_base.plugins import load_calculator
 from thorvald_base.verification import (
     BALANCE_LEGS,
     BALANCE_SPEED,
+    SPEED,
+    STRAIGHT_PAUSE,
     balance_legs,
     commanded_path,
     duration,
@@ -124,7 +126,7 @@ def _truthful(drive):
 
 def test_a_manoeuvre_of_another_name_or_a_bad_side_is_refused():
     config = four_ws()
-    with pytest.raises(ValueError, match="must be one of verification, calibration, field, balance, not 'umbmark'"):
+    with pytest.raises(ValueError, match="one of verification, calibration, field, balance, straight, not 'umbmark'"):
         plan_named("umbmark", config)
     with pytest.raises(ValueError, match="side must be a positive length"):
         plan_named("calibration", config, side=0.0)
@@ -173,3 +175,24 @@ def test_the_balancing_drive_is_straight_legs_both_ways_every_wheel_straight_at_
             # a wheel rolling backwards on a forward leg would read its torque with the wrong sign
             assert math.copysign(1, cmd.speed * math.cos(cmd.steering)) == math.copysign(1, speed)
         assert twist_at(plan, end + 0.5) == twist_at(plan, end + 2.5)  # standing: the pause
+
+
+@pytest.mark.parametrize("path", EXAMPLE_ROBOTS, ids=lambda p: os.path.basename(p)[:-5])
+def test_the_straight_drive_is_legs_on_one_line_with_stops_every_wheel_straight(path):
+    config = load_robot_config(path)
+    calc = load_calculator(config)
+    _, plan = plan_named("straight", config, side=3.0)
+    track = poses(plan)
+    assert math.hypot(track[-1].x, track[-1].y) < 1e-6  # back at the start, within the side of it
+    assert max(math.hypot(p.x, p.y) for p in track) <= 3.0 + 1e-6
+    assert max(abs(p.yaw) for p in track) < 1e-12  # never turns
+    assert commanded_path(plan)[1] == pytest.approx(8 * 3.0)
+    moving = [s for s in plan if s.twist != Twist()]
+    assert len(moving) == 5 and [s.label for s in plan[::2]] == ["stop"] * 6  # a stop before and after each leg
+    assert all(s.duration == STRAIGHT_PAUSE for s in plan[::2])
+    for seg in moving:
+        result = calc.calculate_command(seg.twist)
+        assert not result.changed
+        for cmd in result.commands:  # every wheel straight, at the working speed
+            assert abs(math.remainder(cmd.steering, math.pi)) < 1e-9
+            assert abs(cmd.speed) == pytest.approx(SPEED)

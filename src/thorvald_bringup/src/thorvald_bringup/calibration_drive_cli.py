@@ -13,6 +13,13 @@ and offset, which combinations of them the drive determines, the odometry before
 calibration file written. A real robot drives the same manoeuvre with ``calibration_drive.launch`` on
 its own master and records what ``calibrate_odometry --ground-truth gnss`` reads.
 
+A robot of more than two drives (whose wheels can fight on one rigid frame) goes on, unless
+``--no-balance``: balance_wheels drives straight legs slowly with that calibration in effect and
+sets each tyre's radius against the others' from the motors' currents (balanced.yaml); the
+calibration drive's fit is taken again with it (``calibrate_odometry --balance``,
+balanced_calibration.yaml); and the straight manoeuvre, driven at working speed with that in effect,
+gives the radii's common factor (``calibrate_odometry --fit scale``): calibration.yaml.
+
 Exit status 0 with the calibration; 2 with the reason on stderr (a robot file's problems, one per
 line; otherwise one line) and no traceback.
 """
@@ -39,6 +46,8 @@ CALIBRATION = "calibration.yaml"  # what base_driver loads: the final calibratio
 ODOMETRY = "odometry_calibration.yaml"  # before the balance: calibrated from ground truth alone
 BALANCED = "balanced.yaml"  # balance_wheels': the radii where the wheels do not fight
 BALANCE_JSON = "balance.json"
+BALANCED_FIT = "balanced_calibration.yaml"  # the calibration drive's fit with the balance, before the straight legs
+STRAIGHT_BAG = "straight.bag"
 
 
 def parser() -> argparse.ArgumentParser:
@@ -126,7 +135,7 @@ def run(args) -> int:
     balanced_file = os.path.join(out, BALANCED)
     figures = os.path.join(out, BALANCE_JSON)
     final = os.path.join(out, CALIBRATION)
-    for stale in (balanced_file, figures, final):
+    for stale in (balanced_file, figures, final, os.path.join(out, BALANCED_FIT)):
         if os.path.exists(stale):
             os.remove(stale)
     launch_args = [f"robot_model:={model}", f"side:={args.side:g}", f"out:={balanced_file}", f"json:={figures}"]
@@ -148,9 +157,28 @@ def run(args) -> int:
             "\nthe calibration drive's fit, each radius moved to the balance's along what that drive did not determine:"
         )
     # the calibration drive's fit again, with the balance
+    balanced_fit = os.path.join(out, BALANCED_FIT)
     captured = io.StringIO()
     with contextlib.redirect_stdout(captured):
-        status = calibrate_odometry([*command[:4], final, *command[5:], "--balance", balanced_file])
+        status = calibrate_odometry([*command[:4], balanced_fit, *command[5:], "--balance", balanced_file])
+    if status != 0:
+        print(captured.getvalue(), end="")
+        return status
+    fit_text = captured.getvalue()
+    if not args.json:
+        print(fit_text, end="", flush=True)
+    # the radii's common factor, from straight legs at working speed with all that in effect
+    straight_bag = os.path.join(out, STRAIGHT_BAG)
+    with_fit = argparse.Namespace(**{**vars(args), "calibration": balanced_fit})
+    wall = drive(with_fit, model, straight_bag, "straight", args.side, log="straight")
+    scale = [straight_bag, "--robot-model", model, "--out", final, "--calibration", balanced_fit, "--fit", "scale"]
+    scale += ["--ground-truth", args.ground_truth, *(["--json"] if args.json else [])]
+    if not args.json:
+        print(f"  drive: {wall:.1f} s wall; bag {straight_bag}", flush=True)
+        print("\nthe radii's common factor from the straight legs, that calibration in effect:")
+    captured = io.StringIO()
+    with contextlib.redirect_stdout(captured):
+        status = calibrate_odometry(scale)
     if status != 0:
         print(captured.getvalue(), end="")
         return status
@@ -158,9 +186,10 @@ def run(args) -> int:
     tyres = None
     if args.as_built:
         tyres = tyre_errors(config, built, load_calibration(first, config), balanced, load_calibration(final, config))
-    if args.json:
-        result = json.loads(text[text.index("{") :])
+    if args.json:  # the calibration drive's fit (with the balance), the balance, the straight legs' factor
+        result = json.loads(fit_text[fit_text.index("{") :])
         result["balance"] = balanced
+        result["straight"] = json.loads(text[text.index("{") :])
         if tyres is not None:
             result["tyres"] = tyres
         print(json.dumps(result, indent=2))

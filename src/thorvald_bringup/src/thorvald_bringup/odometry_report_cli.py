@@ -99,13 +99,15 @@ def robot_file(args) -> str:
     return path
 
 
-def drive(args, model: str, bag: str, manoeuvre: str = "verification", side: float = SIDE) -> float:
+def drive(
+    args, model: str, bag: str, manoeuvre: str = "verification", side: float = SIDE, *, log: str = "odometry_report"
+) -> float:
     """Runs odometry_report.launch until the drive ends; returns the wall time [s]. args: world,
-    real_time_factor, gui, as_built, calibration, timeout."""
+    real_time_factor, gui, as_built, calibration, timeout; its output in log_launch.log beside the bag."""
     for stale in (bag, bag + ".active"):
         if os.path.exists(stale):
             os.remove(stale)
-    log = os.path.join(os.path.dirname(bag), "odometry_report_launch.log")
+    log = os.path.join(os.path.dirname(bag), f"{log}_launch.log")
     wall, text = run_launch(
         args, "odometry_report.launch", [f"robot_model:={model}", f"bag:={bag}", f"manoeuvre:={manoeuvre}",
         f"side:={side:g}"], log, f"{os.path.basename(model)[:-5]} through the {manoeuvre} manoeuvre",

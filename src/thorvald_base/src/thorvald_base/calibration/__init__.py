@@ -13,6 +13,8 @@ result as a file base_driver loads at start (``~calibration``) and reads it back
 * :mod:`.estimate`: the model, the least squares, uncertainties and excitation;
 * :mod:`.observable`: which combinations a drive determines through the odometry, and a fit of
   those alone, the rest kept at the values in effect;
+* :mod:`.scale`: the radii's common factor alone, from straight legs between standstills;
+* :mod:`.torque_balance`: each tyre's radius against the others', from the wheels' torques;
 * :mod:`.odometry_error`: odometry against ground truth, before and after;
 * :mod:`.calibration_file`: the file base_driver loads, and the set_drive_params call.
 
@@ -40,6 +42,7 @@ from .estimate import (
 from .observable import Combination, ObservableFit, observable_fit
 from .odometry_error import OdometryError, as_read_with, odometry_error, replay, truth_path
 from .recording import DriveRecording, GnssTruth, PoseTruth, local_metres
+from .scale import ScaleFit, common_scale
 
 __all__ = [
     "GNSS",
@@ -55,10 +58,12 @@ __all__ = [
     "OdometryError",
     "ParameterEstimate",
     "PoseTruth",
+    "ScaleFit",
     "as_read_with",
     "calibrate",
     "calibration_dict",
     "calibration_yaml",
+    "common_scale",
     "load_calibration",
     "local_metres",
     "observable_fit",

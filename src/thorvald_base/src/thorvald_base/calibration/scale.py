@@ -1,0 +1,146 @@
+"""The radii's common factor alone, from straight legs driven between standstills.
+
+Why. The calibration drive determines the combinations of the radii and offsets that its odometry
+saw; the common factor of the radii it takes mostly from turns and spins, where the wheels slip
+sideways and fight through the turn. A field robot drives most of its distance straight along rows,
+and there every radius reads a little differently (a -0.1 to -0.6 % distance error on the field
+route after the calibration drive and the balance, docs/odometry-report.md). Driven again, straight,
+with the calibration in effect (offsets calibrated and the wheels balanced, so nothing fights), the
+legs tell that factor directly: every radius times k scales every rim speed, so base_driver's
+odometry (linear in the rim speeds) moves k times as far.
+
+The measurement. A leg runs from one standstill to the next (no wheel turning faster than MOVING).
+At each standstill, base_link's position is averaged over the standstill's second half (the robot
+settled on its tyres): ground truth's (the simulator's pose, or GNSS fixes, whose noise averages out
+there, where a path length would grow with it) and odometry's (the drive states replayed with the
+values in effect). The factor is k = sum of ground truth's leg lengths / sum of odometry's. A leg
+whose odometry path is more than STRAIGHT longer than its chord turned, and is left out: a chord
+tells a path's length only on a straight leg. The standard uncertainty is that of the legs' ratios
+about k (a regression through the origin), nan with a single leg.
+
+GNSS: the antenna's lever arm cancels between standstills of one heading (a straight leg does not
+turn), so the IMU's yaw is not needed.
+
+Pure: numpy, no rospy, no messages.
+"""
+
+import math
+from dataclasses import dataclass
+from typing import Callable, List, Tuple, Union
+
+import numpy as np
+
+from thorvald_model.values import RobotConfig
+
+from ..errors import CalibrationError
+from ..plugins import load_calculator
+from .estimate import GNSS, MOVING, SIMULATOR, Calibration, ParameterEstimate
+from .odometry_error import replay, truth_path
+from .recording import DriveRecording, GnssTruth, PoseTruth
+
+STILL = 0.5  # [s] a standstill shorter than this does not end a leg
+MIN_LEG = 0.5  # [m] of odometry: a shorter leg tells little of a factor
+STRAIGHT = 0.005  # a leg whose odometry path is longer than its chord by more than this share turned
+
+
+@dataclass(frozen=True)
+class Leg:
+    start: float  # [s] the mean time of the standstill before it
+    end: float  # [s] and after it
+    truth_m: float  # ground truth's chord [m]
+    odometry_m: float  # odometry's chord [m]
+    path_m: float  # odometry's path length [m]
+
+    @property
+    def straight(self) -> bool:
+        return self.odometry_m >= MIN_LEG and self.path_m <= self.odometry_m * (1.0 + STRAIGHT)
+
+
+@dataclass(frozen=True)
+class ScaleFit:
+    factor: float  # k: every radius times this
+    sd: float  # its standard uncertainty [-] (nan from a single leg)
+    legs: Tuple[Leg, ...]  # every leg between standstills, straight or not
+    ground_truth: str  # SIMULATOR or GNSS
+
+    @property
+    def used(self) -> Tuple[Leg, ...]:
+        return tuple(leg for leg in self.legs if leg.straight)
+
+    def calibration(self, config: RobotConfig) -> Calibration:
+        """Every radius of the configuration in effect times the factor; the offsets kept."""
+        parameters = []
+        for i, drive in enumerate(config.drives):
+            r = drive.r_wheel
+            parameters.append(ParameterEstimate(f"drive{i}", i, "r_wheel", r * self.factor, r * self.sd, r, True))
+            if drive.steerable:
+                reason = "the common factor of the radii alone was fitted (--fit scale)"
+                parameters.append(
+                    ParameterEstimate(
+                        f"drive{i}", i, "steering_offset", drive.steering_offset, math.nan, drive.steering_offset,
+                        False, reason,
+                    )
+                )  # fmt: skip
+        used = self.used
+        rms = math.sqrt(sum((leg.truth_m - self.factor * leg.odometry_m) ** 2 for leg in used) / len(used))
+        return Calibration(self.ground_truth, tuple(parameters), None, rms, len(used), 0.0)
+
+
+def common_scale(
+    config: RobotConfig,
+    recording: DriveRecording,
+    truth: Union[PoseTruth, GnssTruth],
+    calculator_for: Callable = load_calculator,
+) -> ScaleFit:
+    """The radii's common factor from the straight legs between the recording's standstills (the
+    module's docstring); CalibrationError when it holds no straight leg of at least MIN_LEG."""
+    if recording.drives != len(config.drives):
+        raise CalibrationError(f"the recording has {recording.drives} drives, the robot {len(config.drives)}")
+    t_odo, x_odo, y_odo, _ = replay(config, recording, calculator_for)
+    t, x, y, _ = truth_path(truth)
+    along = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x_odo), np.diff(y_odo)))])
+    stands = []
+    for a, b in _standstills(recording):
+        half = (t_odo >= (a + b) / 2.0) & (t_odo <= b)
+        seen = (t >= (a + b) / 2.0) & (t <= b)
+        if np.any(seen):  # ground truth holds samples there
+            odo = (float(np.mean(x_odo[half])), float(np.mean(y_odo[half])), float(np.mean(along[half])))
+            stands.append(((a + b) / 2.0, float(np.mean(x[seen])), float(np.mean(y[seen])), odo))
+    legs = []
+    for (ta, xa, ya, oa), (tb, xb, yb, ob) in zip(stands, stands[1:]):
+        chord = math.hypot(ob[0] - oa[0], ob[1] - oa[1])
+        legs.append(Leg(ta, tb, math.hypot(xb - xa, yb - ya), chord, ob[2] - oa[2]))
+    used = [leg for leg in legs if leg.straight]
+    if not used:
+        raise CalibrationError(
+            f"--fit scale: no straight leg of at least {MIN_LEG:g} m between two standstills of at least {STILL:g} s "
+            f"({len(legs)} legs, {sum(leg.odometry_m >= MIN_LEG for leg in legs)} long enough): drive straight "
+            "legs with stops between them (the straight manoeuvre)"
+        )
+    truth_m = np.array([leg.truth_m for leg in used])
+    odo_m = np.array([leg.odometry_m for leg in used])
+    factor = float(np.sum(truth_m) / np.sum(odo_m))
+    sd = math.nan
+    if len(used) > 1:
+        rest = truth_m - factor * odo_m
+        sd = float(math.sqrt(np.sum(rest**2) / (len(used) - 1) / np.sum(odo_m**2)))
+    return ScaleFit(factor, sd, tuple(legs), GNSS if isinstance(truth, GnssTruth) else SIMULATOR)
+
+
+def _standstills(recording: DriveRecording) -> List[Tuple[float, float]]:
+    """(first, last sample time [s]) of each run of samples where no wheel turns faster than MOVING,
+    lasting at least STILL."""
+    still = np.max(np.abs(recording.speed), axis=1, initial=0.0) <= MOVING
+    out, first = [], None
+    for n, s in enumerate(still):
+        if s and first is None:
+            first = n
+        if first is not None and (not s or n == len(still) - 1):
+            last = n if s else n - 1
+            if recording.t[last] - recording.t[first] >= STILL:
+                out.append((float(recording.t[first]), float(recording.t[last])))
+            first = None
+    return out
+
+
+__all__ = ["MIN_LEG", "STILL", "STRAIGHT", "Leg", "ScaleFit", "common_scale"]
