@@ -23,6 +23,7 @@ from typing import List, Optional
 from thorvald_model.errors import ConfigError
 
 from .errors import ThorvaldSimError
+from .physics import PRESETS
 from .runner import RunOptions, read_commands, run_robot
 
 
@@ -38,6 +39,9 @@ def parse_args(argv: Optional[List[str]] = None) -> argparse.Namespace:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--hold", type=float, default=1.0, help="[s] the last command holds (1)")
     parser.add_argument("--record-sensors", action="store_true")
+    parser.add_argument(
+        "--physics", choices=tuple(PRESETS), default="default", help="the physics preset (default; fleet: cheaper)"
+    )
     return parser.parse_args(argv)
 
 
@@ -54,6 +58,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         seed=args.seed,
         record_sensors=args.record_sensors,
         hold=args.hold,
+        physics=args.physics,
     )
     try:
         commands = read_commands(args.commands)

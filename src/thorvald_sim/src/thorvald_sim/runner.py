@@ -56,6 +56,7 @@ from thorvald_model.description import generate_urdf
 from thorvald_model.errors import MISSING, ConfigError, Problem
 
 from .as_built import as_built_for, for_simulator
+from .physics import physics_settings
 from .robot import Pose2D, Vec3
 from .simulation import Simulation
 from .world import WorldConfig, load_world, resolve_world
@@ -97,7 +98,9 @@ class RunOptions:
     yaw: float = 0.0  # [rad]
     roll: float = 0.0  # [rad] set down tilted (on a slope); the odom frame stays level
     pitch: float = 0.0  # [rad]
-    physics_rate: float = 240.0  # [Hz], the simulator's
+    physics: str = "default"  # the simulator's physics preset (thorvald_sim.physics: default, fleet)
+    physics_rate: Optional[float] = None  # [Hz], the simulator's; None: the preset's
+    solver_iterations: Optional[int] = None  # None: the preset's
     clock_rate: float = 80.0  # [Hz], the simulator's ~clock_rate: the instants base_driver answers
     driver: Dict = field(default_factory=dict)  # base_driver's private parameters (rate, estimator, ...)
 
@@ -255,10 +258,13 @@ class RobotSession:
             robot_file, tf_prefix=options.tf_prefix, model_extras=options.model_extras, robot_name=options.robot_name
         )
         as_built = for_simulator(as_built_for(options.as_built, config), config) if options.as_built else None
+        physics = physics_settings(options.physics, options.physics_rate, options.solver_iterations)  # ValueError
         self.world = world if world is not None else load_world(resolve_world(options.world))
         self.client = client = p.connect(p.DIRECT)
         try:
-            self.sim = sim = Simulation(client, self.world, options.physics_rate, seed=options.seed)
+            self.sim = sim = Simulation(
+                client, self.world, physics.rate, seed=options.seed, solver_iterations=physics.solver_iterations
+            )
             pose = Pose2D(options.x, options.y, options.z, options.yaw, options.roll, options.pitch)
             self.robot = sim.spawn(options.robot_name, urdf, pose, as_built)
             calculator = load_calculator(config, estimator=driver.estimator, projection=driver.projection)

@@ -16,13 +16,14 @@ from thorvald_model.urdf_check import UrdfCheckError
 from .as_built import SimAsBuilt
 from .description import DescriptionError, MeshFinder, mesh_finder, spawned_description
 from .errors import SpawnError
+from .physics import PRESETS
 from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
 from .scene import build_scene
 from .sensor_blocks import Datum
 from .sensors import build_sensors
 from .world import WorldConfig
 
-SOLVER_ITERATIONS = 50  # pybullet's default, set explicitly
+SOLVER_ITERATIONS = PRESETS["default"].solver_iterations  # pybullet's default, set explicitly
 
 
 def installed_package_path(package: str) -> Optional[str]:
@@ -57,9 +58,12 @@ class Simulation:
         *,
         seed: int = 0,
         datum: Optional[Datum] = None,
+        solver_iterations: int = SOLVER_ITERATIONS,
     ):
         if not physics_rate > 0:
             raise ValueError(f"physics_rate: {physics_rate!r}: must be > 0 [Hz]")
+        if isinstance(solver_iterations, bool) or not (isinstance(solver_iterations, int) and solver_iterations >= 1):
+            raise ValueError(f"solver_iterations: {solver_iterations!r}: must be a whole number >= 1")
         if not tyre_contact_width > 0.0:
             raise ValueError(f"tyre_contact_width: {tyre_contact_width!r}: must be > 0 [m]")
         self.tyre_contact_width = tyre_contact_width
@@ -69,8 +73,9 @@ class Simulation:
         self.find_mesh = find_mesh or mesh_finder(installed_package_path)
         self.client = client
         self.dt = 1.0 / physics_rate
+        self.solver_iterations = solver_iterations
         p.setPhysicsEngineParameter(
-            fixedTimeStep=self.dt, numSolverIterations=SOLVER_ITERATIONS, physicsClientId=client
+            fixedTimeStep=self.dt, numSolverIterations=solver_iterations, physicsClientId=client
         )
         self.scene = build_scene(client, world)
         self.robots: Dict[str, SimRobot] = {}

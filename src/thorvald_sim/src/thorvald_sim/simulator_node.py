@@ -14,7 +14,11 @@ Private parameters:
 ``~world``                a shipped world's name (``flat``, ``tarmac_gravel``, ``slope``,
                           ``greenhouse``) or a world file (default ``flat``)
 ``~gui``                  open pybullet's window (default false: headless)
-``~physics_rate``         physics steps per simulated second [Hz] (240)
+``~physics``              the physics preset (:mod:`thorvald_sim.physics`): ``default`` (240 Hz,
+                          50 solver iterations) or ``fleet`` (120 Hz, 50: about half the CPU
+                          per robot)
+``~physics_rate``         physics steps per simulated second [Hz] (the preset's)
+``~solver_iterations``    pybullet's solver iterations per step (the preset's)
 ``~real_time_factor``     simulated seconds per wall second (1); 0 runs as fast as it can
 ``~clock_rate``           /clock messages per simulated second [Hz] (80: every third step at 240 Hz
                           physics; at most one a step)
@@ -240,8 +244,10 @@ class SimulatorNode:
         self.followers = FollowerWait()  # without lockstep: robots whose commands lag ~max_lag behind
         self.client = p.connect(p.GUI if self.gui else p.DIRECT)
         self.sim = Simulation(
-            self.client, world, params.physics_rate, params.tyre_contact_width, seed=params.seed, datum=datum
-        )
+            self.client, world, params.physics_rate, params.tyre_contact_width, seed=params.seed, datum=datum,
+            solver_iterations=params.solver_iterations,
+        )  # fmt: skip
+        self.physics = params.physics
         self.lock = threading.RLock()
         self.missing_meshes_said = set()  # mesh URIs warned about: once each, however many robots name them
         self.io = {}
@@ -269,10 +275,12 @@ class SimulatorNode:
         rospy.Service("~snapshot", Snapshot, self.srv_snapshot)
         self.publish_clock()
         rospy.loginfo(
-            "simulator: world %s (%s), %.0f Hz physics, real-time factor %s%s",
+            "simulator: world %s (%s), physics %s: %g Hz, %d solver iterations, real-time factor %s%s",
             params.world,
             world.source,
+            params.physics,
             params.physics_rate,
+            params.solver_iterations,
             self.real_time_factor or "as fast as possible",
             ", paused" if self.paused else "",
         )
@@ -558,6 +566,8 @@ class SimulatorNode:
             perf, robots=len(self.io), asked=asked, paused=self.paused, physics_rate=1.0 / self.sim.dt,
             simulated_now=self.sim.time,
         )  # fmt: skip
+        simulation[2]["physics preset"] = self.physics
+        simulation[2]["solver iterations"] = str(self.sim.solver_iterations)
         statuses = [conversions.diagnostic_status(rospy.get_name() + ": simulation", "pybullet", *simulation)]
         statuses += [
             conversions.diagnostic_status(f"{rospy.get_name()}: sensors of {name}", name, *report)

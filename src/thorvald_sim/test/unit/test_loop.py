@@ -159,7 +159,16 @@ def test_parameters_are_read_once_with_their_defaults():
     params = SimulatorParams.read(get)
     assert params == SimulatorParams(real_time_factor=0.0, seed=7, world="slope")
     assert params.clock_rate == 80.0 and params.publish_tf is True
-    assert len(asked) == len(set(asked)) == 16  # every parameter, each once
+    assert len(asked) == len(set(asked)) == 18  # every parameter, each once
+    assert (params.physics, params.physics_rate, params.solver_iterations) == ("default", 240.0, 50)
+
+
+def test_the_physics_preset_gives_the_rate_and_iterations_unless_they_are_given():
+    fleet = SimulatorParams.read(lambda n, d: "fleet" if n == "physics" else d)
+    assert (fleet.physics, fleet.physics_rate, fleet.solver_iterations) == ("fleet", 120.0, 50)
+    given = {"physics": "fleet", "physics_rate": 200, "solver_iterations": 30}
+    mixed = SimulatorParams.read(given.get)
+    assert (mixed.physics_rate, mixed.solver_iterations) == (200.0, 30)
 
 
 @pytest.mark.parametrize(
@@ -172,6 +181,9 @@ def test_parameters_are_read_once_with_their_defaults():
         ("real_time_factor", -1, "must be >= 0"),
         ("seed", 1.5, "must be a whole number"),
         ("seed", True, "must be a whole number"),
+        ("physics", "fast", "must be one of default, fleet"),
+        ("solver_iterations", 0, "must be a whole number in 1..1000"),
+        ("solver_iterations", 12.5, "must be a whole number in 1..1000"),
     ],
 )
 def test_a_bad_parameter_is_refused_with_its_name_value_and_rule(name, value, rule):
