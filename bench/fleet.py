@@ -2,7 +2,7 @@
 """Fleets in one simulation: the largest fleet this machine holds at real time, and where the CPU goes.
 
     python bench/fleet.py [--seconds 60] [--robots 4 8 12 16 20] [--lidar-robots 4 8 12]
-                          [--stacks per-robot fleet] [--plot docs/images/fleet/rtf.png]
+                          [--stacks per-robot fleet] [--physics default fleet] [--plot docs/images/fleet/rtf.png]
 
 Each case is one roslaunch on the benchmark's own master: simulator.launch at real time
 (real_time_factor 1) in the flat world, and N standard robots (thorvald_ii_4wd4ws_std) brought up
@@ -15,7 +15,10 @@ scan is read (the simulator measures a sensor only while somebody reads it).
 
 Stacks: ``per-robot`` is the stack as it is (base_driver and twist_mux processes per robot);
 ``fleet`` runs every robot's base_driver and twist_mux in one fleet_driver process
-(``fleet_driver:=true``), the same topics, services and parameters per robot.
+(``fleet_driver:=true``), the same topics, services and parameters per robot. ``--physics`` runs
+each stack with each physics preset (simulator.launch's ``physics``: ``default``, or ``fleet``: 120
+Hz, about half the solver's CPU); a stack on a preset other than the default is labelled
+``STACK+PRESET``.
 
 Figures per case, over ``--seconds`` simulated seconds after 5 s of warm-up:
 - real-time factor (simulated seconds per wall second); held: at least 0.95;
@@ -70,7 +73,7 @@ def twist_of(k):
     return 0.30 + 0.02 * (k % 5), 0.3 if k % 2 else -0.3
 
 
-def launch_file(n: int, lidar: bool, stack: str, rtf: float = 1.0):
+def launch_file(n: int, lidar: bool, stack: str, rtf: float = 1.0, physics: str = "default"):
     extras = f'<arg name="model_extras" value="{LIDAR}"/>' if lidar else ""
     robots = "\n".join(
         f'  <include file="$(find thorvald_bringup)/launch/sim_robot_in_world.launch"><arg name="ns" value="r{k}"/>'
@@ -88,7 +91,7 @@ def launch_file(n: int, lidar: bool, stack: str, rtf: float = 1.0):
     return (
         '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'
         f'<arg name="world" value="flat"/><arg name="real_time_factor" value="{rtf:g}"/>'
-        '<arg name="output" value="log"/>'
+        f'<arg name="physics" value="{physics}"/><arg name="output" value="log"/>'
         f"</include>\n{robots}\n{fleet}</launch>\n"
     )
 
@@ -114,7 +117,7 @@ def _ignore(_msg):
     pass
 
 
-def case(n: int, lidar: bool, stack: str, seconds: float, *, master, rtf: float = 1.0):
+def case(n: int, lidar: bool, stack: str, seconds: float, *, master, rtf: float = 1.0, physics: str = "default"):
     """{figure: value} of one fleet, on the benchmark's master."""
     import rospy  # noqa: PLC0415
     from diagnostic_msgs.msg import DiagnosticArray  # noqa: PLC0415
@@ -124,7 +127,7 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master, rtf: float 
 
     from thorvald_testing.topics import Latest  # noqa: PLC0415
 
-    xml = launch_file(n, lidar, stack, rtf)
+    xml = launch_file(n, lidar, stack, rtf, physics)
     clock = Latest("/clock", Clock, queue_size=1)
     solver = []  # the simulator's figure per /diagnostics window while measuring [s per simulated s]
     measuring = threading.Event()
@@ -219,7 +222,7 @@ def print_row(n, lidar, stack, r):
     ms = {role: 1000 * r[role] for role in ROLES}
     total = sum(ms.values())
     print(
-        f"{n:>6} {'yes' if lidar else 'no':>5} {stack:>9} {r['rtf']:>6.2f}{'' if r['rtf'] >= HELD else '*':1}"
+        f"{n:>6} {'yes' if lidar else 'no':>5} {stack:>13} {r['rtf']:>6.2f}{'' if r['rtf'] >= HELD else '*':1}"
         + "".join(f" {ms[role]:>8.1f}" for role in ROLES)
         + f" {total:>7.1f} {total / ms['solver']:>7.1f}x {(ms['simulator'] + ms['solver']) / ms['solver']:>7.2f}x",
         flush=True,
@@ -255,6 +258,7 @@ def main() -> int:
     parser.add_argument("--robots", type=int, nargs="*", default=[4, 8, 12, 16, 20], help="fleet sizes")
     parser.add_argument("--lidar-robots", type=int, nargs="*", default=[4, 8, 12], help="fleet sizes with a lidar each")
     parser.add_argument("--stacks", nargs="+", default=["per-robot", "fleet"], choices=["per-robot", "fleet"])
+    parser.add_argument("--physics", nargs="+", default=["default"], choices=["default", "fleet"])
     parser.add_argument(
         "--real-time-factor", type=float, default=1.0, help="the simulator's pace (1; 0: as fast as it can)"
     )
@@ -266,7 +270,7 @@ def main() -> int:
     cases = [(n, False) for n in args.robots] + [(n, True) for n in args.lidar_robots]
     print("CPU per robot and simulated second [ms]; * below 0.95 of real time")
     print(
-        f"{'robots':>6} {'lidar':>5} {'stack':>9} {'RTF':>7}"
+        f"{'robots':>6} {'lidar':>5} {'stack':>13} {'RTF':>7}"
         + "".join(f" {role[:8]:>8}" for role in ROLES)
         + f" {'total':>7} {'/solver':>8} {'sim/solv':>8}"
     )
@@ -279,9 +283,11 @@ def main() -> int:
     with ros_session("bench_fleet", core_only=True) as (master, _):
         for n, lidar in cases:
             for stack in args.stacks:
-                r = case(n, lidar, stack, args.seconds, master=master, rtf=args.real_time_factor)
-                results.setdefault((lidar, stack), {})[n] = r
-                print_row(n, lidar, stack, r)
+                for physics in args.physics:
+                    r = case(n, lidar, stack, args.seconds, master=master, rtf=args.real_time_factor, physics=physics)
+                    label = stack if physics == "default" else f"{stack}+{physics}"
+                    results.setdefault((lidar, label), {})[n] = r
+                    print_row(n, lidar, label, r)
     if args.json:
         rows = [
             {"robots": n, "lidar": lidar, "stack": stack, "figures": r}
