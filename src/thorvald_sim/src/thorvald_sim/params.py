@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from .errors import ParameterError
-from .physics import MAX_ITERATIONS, PRESETS
+from .physics import PRESETS, physics_settings
 
 Getter = Callable[[str, Any], Any]
 
@@ -24,8 +24,8 @@ class SimulatorParams:
     world: str = "flat"
     gui: bool = False
     physics: str = "default"  # the preset (thorvald_sim.physics.PRESETS)
-    physics_rate: float = 240.0  # [Hz]; read: the preset's unless given
-    solver_iterations: int = 50  # read: the preset's unless given
+    physics_rate: float = PRESETS["default"].rate  # [Hz]; read: the preset's unless given
+    solver_iterations: int = PRESETS["default"].solver_iterations  # read: the preset's unless given
     real_time_factor: float = 1.0  # 0: as fast as the machine can
     clock_rate: float = 80.0  # [Hz] of simulated time: every third step at 240 Hz physics
     odometry_rate: float = 50.0  # [Hz]
@@ -48,18 +48,16 @@ class SimulatorParams:
         if isinstance(seed, bool) or not isinstance(seed, int):
             raise ParameterError(f"~seed: {seed!r}: must be a whole number")
         physics = get("physics", d.physics)
-        if physics not in PRESETS:
-            raise ParameterError(f"~physics: {physics!r}: must be one of {', '.join(PRESETS)}")
-        preset = PRESETS[physics]
-        iterations = get("solver_iterations", preset.solver_iterations)
-        if isinstance(iterations, bool) or not isinstance(iterations, int) or not 1 <= iterations <= MAX_ITERATIONS:
-            raise ParameterError(f"~solver_iterations: {iterations!r}: must be a whole number in 1..{MAX_ITERATIONS}")
+        try:  # unset: the preset's
+            preset = physics_settings(physics, None, get("solver_iterations", None))
+        except ValueError as e:
+            raise ParameterError(f"~{e}") from None
         return cls(
             world=str(get("world", d.world)),
             gui=bool(get("gui", d.gui)),
             physics=physics,
             physics_rate=_number(get, "physics_rate", preset.rate),
-            solver_iterations=iterations,
+            solver_iterations=preset.solver_iterations,
             real_time_factor=_number(get, "real_time_factor", d.real_time_factor, allow_zero=True),
             clock_rate=_number(get, "clock_rate", d.clock_rate),
             odometry_rate=_number(get, "odometry_rate", d.odometry_rate),

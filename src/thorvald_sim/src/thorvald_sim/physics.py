@@ -39,17 +39,18 @@ MAX_ITERATIONS = 1000
 def physics_settings(name: str = "default", rate: Optional[float] = None, solver_iterations: Optional[int] = None):
     """The preset ``name`` with an explicit rate [Hz] or iteration count in place of its own;
     ValueError naming the setting, the value and the rule."""
-    if name not in PRESETS:
+    if not isinstance(name, str) or name not in PRESETS:
         raise ValueError(f"physics: {name!r}: must be one of {', '.join(PRESETS)}")
     preset = PRESETS[name]
     if rate is not None:
         if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not (math.isfinite(rate) and rate > 0):
             raise ValueError(f"physics_rate: {rate!r}: must be a number > 0 [Hz]")
-    if solver_iterations is not None:
-        if isinstance(solver_iterations, bool) or not isinstance(solver_iterations, int):
-            raise ValueError(f"solver_iterations: {solver_iterations!r}: must be a whole number")
-        if not 1 <= solver_iterations <= MAX_ITERATIONS:
-            raise ValueError(f"solver_iterations: {solver_iterations!r}: must be in 1..{MAX_ITERATIONS}")
+    if solver_iterations is not None and (
+        isinstance(solver_iterations, bool)
+        or not isinstance(solver_iterations, int)
+        or not 1 <= solver_iterations <= MAX_ITERATIONS
+    ):
+        raise ValueError(f"solver_iterations: {solver_iterations!r}: must be a whole number in 1..{MAX_ITERATIONS}")
     return Physics(
         preset.name,
         float(rate) if rate is not None else preset.rate,

@@ -182,6 +182,7 @@ def test_the_physics_preset_gives_the_rate_and_iterations_unless_they_are_given(
         ("seed", 1.5, "must be a whole number"),
         ("seed", True, "must be a whole number"),
         ("physics", "fast", "must be one of default, fleet"),
+        ("physics", ["fleet"], "must be one of default, fleet"),
         ("solver_iterations", 0, "must be a whole number in 1..1000"),
         ("solver_iterations", 12.5, "must be a whole number in 1..1000"),
     ],
