@@ -31,7 +31,7 @@ from thorvald_model import load_robot_config
 from thorvald_model.description import generate_urdf
 from thorvald_sim.physics import PRESETS
 from thorvald_sim.robot import Pose2D
-from thorvald_sim.runner import RunOptions, TimedTwist, run_robot
+from thorvald_sim.runner import RunOptions, commands_from_plan, run_robot
 from thorvald_sim.simulation import Simulation
 from thorvald_sim.world import load_world, resolve_world
 
@@ -67,13 +67,7 @@ def cost(preset: str, n: int, seconds: float):
 
 
 def paper(robot: str, preset: str):
-    config = load_robot_config(robot)
-    _, plan = plan_for(config)
-    commands, t = [], 1.0
-    for seg in plan:
-        commands.append(TimedTwist(t, seg.twist.vx, seg.twist.vy, seg.twist.wz))
-        t += seg.duration
-    commands.append(TimedTwist(t, 0.0, 0.0, 0.0))
+    commands = commands_from_plan(plan_for(load_robot_config(robot))[1], 1.0)
     cpu = time.process_time()
     run = run_robot(robot, commands, RunOptions(world="tarmac_gravel", physics=preset))
     return run, time.process_time() - cpu

@@ -31,21 +31,14 @@ import time
 from thorvald_base.verification import plan_for
 from thorvald_model import load_robot_config
 from thorvald_model.description import package_file
-from thorvald_sim.runner import RunOptions, TimedTwist, run_robot
+from thorvald_sim.runner import RunOptions, commands_from_plan, run_robot
 
 TARGET = 30.0  # simulated seconds per wall second, one robot, one core
 START = 3.0  # [s] the manoeuvre's first command, as verification_drive's in a paused lockstep run
 
 
 def commands_for(robot_file: str):
-    _, plan = plan_for(load_robot_config(robot_file))
-    t, out = START, []
-    for segment in plan:
-        twist = segment.twist
-        out.append(TimedTwist(t, twist.vx, twist.vy, twist.wz))
-        t += segment.duration
-    out.append(TimedTwist(t, 0.0, 0.0, 0.0))
-    return out
+    return list(commands_from_plan(plan_for(load_robot_config(robot_file))[1], START))
 
 
 def one_run(args):

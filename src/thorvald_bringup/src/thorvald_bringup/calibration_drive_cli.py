@@ -135,7 +135,8 @@ def run(args) -> int:
     balanced_file = os.path.join(out, BALANCED)
     figures = os.path.join(out, BALANCE_JSON)
     final = os.path.join(out, CALIBRATION)
-    for stale in (balanced_file, figures, final, os.path.join(out, BALANCED_FIT)):
+    balanced_fit = os.path.join(out, BALANCED_FIT)
+    for stale in (balanced_file, figures, final, balanced_fit):
         if os.path.exists(stale):
             os.remove(stale)
     launch_args = [f"robot_model:={model}", f"side:={args.side:g}", f"out:={balanced_file}", f"json:={figures}"]
@@ -157,7 +158,6 @@ def run(args) -> int:
             "\nthe calibration drive's fit, each radius moved to the balance's along what that drive did not determine:"
         )
     # the calibration drive's fit again, with the balance
-    balanced_fit = os.path.join(out, BALANCED_FIT)
     captured = io.StringIO()
     with contextlib.redirect_stdout(captured):
         status = calibrate_odometry([*command[:4], balanced_fit, *command[5:], "--balance", balanced_file])

@@ -190,6 +190,17 @@ def write_commands(path: str, commands: Sequence[TimedTwist]) -> None:
 
 
 # ---- the run ----------------------------------------------------------------------------------------
+def commands_from_plan(segments, start: float = 0.0) -> Tuple[TimedTwist, ...]:
+    """A plan's segments (thorvald_base.verification.Segment: twist, duration) as commands from start
+    [s], each held for its segment, then a stop."""
+    t, out = start, []
+    for segment in segments:
+        out.append(TimedTwist(t, segment.twist.vx, segment.twist.vy, segment.twist.wz))
+        t += segment.duration
+    out.append(TimedTwist(t, 0.0, 0.0, 0.0))
+    return tuple(out)
+
+
 def stamp_time(t: float) -> float:
     """t [s] as a ROS stamp carries it: whole nanoseconds, truncated (genpy's Time.from_sec, to_sec)."""
     secs = int(t)
@@ -450,6 +461,7 @@ __all__ = [
     "RunResult",
     "Sample",
     "TimedTwist",
+    "commands_from_plan",
     "parse_commands",
     "path_length",
     "read_commands",

@@ -11,7 +11,15 @@ import pytest
 
 from thorvald_model.description import package_file
 from thorvald_model.errors import ConfigError
-from thorvald_sim.runner import RunOptions, TimedTwist, parse_commands, read_commands, run_robot, stamp_time
+from thorvald_sim.runner import (
+    RunOptions,
+    TimedTwist,
+    commands_from_plan,
+    parse_commands,
+    read_commands,
+    run_robot,
+    stamp_time,
+)
 
 STD = package_file("config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
 SENSORS = package_file("urdf", "examples", "sensors_example.xacro")
@@ -127,11 +135,7 @@ def test_the_fleet_physics_preset_keeps_the_papers_figures_at_half_the_rate():
     from thorvald_sim.simulation import Simulation  # noqa: PLC0415
     from thorvald_sim.world import load_world, resolve_world  # noqa: PLC0415
 
-    commands, t = [], 1.0
-    for seg in plan_for(load_robot_config(STD))[1]:
-        commands.append(TimedTwist(t, seg.twist.vx, seg.twist.vy, seg.twist.wz))
-        t += seg.duration
-    commands.append(TimedTwist(t, 0.0, 0.0, 0.0))
+    commands = commands_from_plan(plan_for(load_robot_config(STD))[1], 1.0)
     runs = {
         name: run_robot(STD, commands, RunOptions(world="tarmac_gravel", physics=name)) for name in ("default", "fleet")
     }
