@@ -89,7 +89,7 @@ from .node_names import Names, Throttle
 from .params import PARAMETER_NAMES, DriverParams
 from .plugins import load_calculator
 from .publishing import BlockingPublisher
-from .stamped_commands import StampedCommands
+from .stamped_commands import LOCKSTEP_BROKEN, StampedCommands
 
 STATUS_PERIOD = 1.0  # [s] between battery_data / motor_controller_data messages
 EXIT_REFUSED = 1  # exit status when the node refuses to start
@@ -314,7 +314,7 @@ class BaseDriverNode:
                     rospy.logwarn(
                         self.label + ": cmd_vel_stamped: no command stamped after %.3f s came (%s): following cmd_vel",
                         t,
-                        "its source left" if now <= deadline else f"waited {STAMPED_WAIT:g} s",
+                        "its source left" if now <= deadline else f"waited {STAMPED_WAIT:g} s; {LOCKSTEP_BROKEN}",
                     )
                     return None
                 self.stamped_arrived.wait(0.01)

@@ -14,6 +14,9 @@ from typing import List, Optional, Tuple
 
 Twist3 = Tuple[float, float, float]  # vx [m/s], vy [m/s], wz [rad/s]
 SAME_INSTANT = 1e-6  # [s]: stamps this close are one instant (a stamp travels as whole nanoseconds, truncated)
+# in every warning of a node in lockstep that gave up waiting (the simulator for a driver's answer,
+# base_driver for its stamped commands): from there on the run depends on timing; a report reading the log says so
+LOCKSTEP_BROKEN = "lockstep broken"
 
 
 class StampedCommands:

@@ -24,7 +24,8 @@ none), ``~connections`` (more such waits: a list of ``"NODE TOPIC"``, e.g. ``"ba
 drive_states"``: every publisher of TOPIC connected to NODE; default none), ``~unpause`` (the
 service that unpauses a simulator started paused, e.g. ``/simulator/unpause``: the drive waits
 for its connections alone, as nothing moves yet, publishes its first stamped commands and
-unpauses, so the run is the same from its first instant; default none), ``~manoeuvre``
+unpauses, so the run is the same from its first instant; the drive's own /clock subscription is
+among the connections waited for; default none), ``~manoeuvre``
 (``verification``, the paper's, the default; or ``calibration``: what calibrate_odometry needs,
 :func:`thorvald_base.verification.plan_named`) and ``~side`` [m] (the calibration drive's square,
 default 4).
@@ -80,6 +81,11 @@ class VerificationDrive:
             self.unconnected.append((rospy.resolve_name(words[0]), rospy.resolve_name(words[1])))
         unpause = str(rospy.get_param("~unpause", "") or "")
         self.unpause = rospy.resolve_name(unpause) if unpause else ""
+        if self.unpause and not self.own_clock:
+            # our steps follow the simulator's /clock, which a paused simulator does not publish: heard
+            # late, the first ticks after the unpause were lost, the first stamped commands after them
+            # never went out, and the world stood 2 s of wall time until the lockstep let the robot go
+            self.unconnected.append((rospy.get_name(), "/clock"))
         self.connections_checked = 0.0  # [s] wall
         ready_topic = str(rospy.get_param("~ready_topic", ""))
         self.ready = not ready_topic

@@ -108,7 +108,7 @@ def run(args) -> int:
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
     bag = os.path.join(out, BAG)
-    wall = drive(args, model, bag, "calibration", args.side)
+    wall, _ = drive(args, model, bag, "calibration", args.side)
     print(f"  drive: {wall:.1f} s wall; bag {bag}", flush=True)
     balance = args.balance if args.balance is not None else fights(config)
     # ROS's Python (rosbag) only now: --help and bad robots stay fast
@@ -170,7 +170,7 @@ def run(args) -> int:
     # the radii's common factor, from straight legs at working speed with all that in effect
     straight_bag = os.path.join(out, STRAIGHT_BAG)
     with_fit = argparse.Namespace(**{**vars(args), "calibration": balanced_fit})
-    wall = drive(with_fit, model, straight_bag, "straight", args.side, log="straight")
+    wall, _ = drive(with_fit, model, straight_bag, "straight", args.side, log="straight")
     scale = [straight_bag, "--robot-model", model, "--out", final, "--calibration", balanced_fit, "--fit", "scale"]
     scale += ["--ground-truth", args.ground_truth, *(["--json"] if args.json else [])]
     if not args.json:

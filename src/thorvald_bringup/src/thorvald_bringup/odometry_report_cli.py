@@ -19,12 +19,15 @@ import argparse
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
 import textwrap
 import time
+from typing import List, Tuple
 
+from thorvald_base.stamped_commands import LOCKSTEP_BROKEN
 from thorvald_base.verification import MANOEUVRES, SIDE
 from thorvald_model import ConfigError, load_robot_config
 from thorvald_model.ports import free_port
@@ -34,6 +37,7 @@ from .errors import DriveError, ReportError, ThorvaldBringupError, UnknownRobot
 
 TARGET_DISTANCE_ERROR = 0.5  # [%] for lsq (the paper: 1.0 %)
 TARGET_END_POINT = 1.0  # [m] for lsq (the paper: 2.2 m)
+ANSI = re.compile(r"\x1b\[[0-9;]*m")  # the colours of rosconsole's lines
 
 
 def parser() -> argparse.ArgumentParser:
@@ -101,9 +105,10 @@ def robot_file(args) -> str:
 
 def drive(
     args, model: str, bag: str, manoeuvre: str = "verification", side: float = SIDE, *, log: str = "odometry_report"
-) -> float:
-    """Runs odometry_report.launch until the drive ends; returns the wall time [s]. args: world,
-    real_time_factor, gui, as_built, calibration, timeout; its output in log_launch.log beside the bag."""
+) -> Tuple[float, List[str]]:
+    """Runs odometry_report.launch until the drive ends; returns the wall time [s] and the log's warnings
+    of a broken lockstep (:func:`lockstep_breaks`). args: world, real_time_factor, gui, as_built,
+    calibration, timeout; its output in log_launch.log beside the bag."""
     for stale in (bag, bag + ".active"):
         if os.path.exists(stale):
             os.remove(stale)
@@ -115,7 +120,25 @@ def drive(
     if "Verification drive of" not in text or not os.path.isfile(bag):
         tail = "\n".join(text.splitlines()[-25:])
         raise DriveError(f"the drive did not finish (no report from verification_drive or no bag); see {log}", tail)
-    return wall
+    return wall, lockstep_breaks(text)
+
+
+def lockstep_breaks(text: str) -> List[str]:
+    """The warnings in a launch's output of a node in lockstep that stopped waiting (the simulator for
+    base_driver's answer, base_driver for its stamped commands, each after 2 s of wall time): from
+    there on what the run commands depends on the machine's timing, so the run may not repeat."""
+    return [ANSI.sub("", line).strip() for line in text.splitlines() if LOCKSTEP_BROKEN in line]
+
+
+def warn_lockstep_breaks(breaks: List[str], log: str) -> None:
+    if breaks:
+        print(
+            f"WARNING: the lockstep was broken, so this run may not repeat (see {log}):\n"
+            + "".join(f"  | {line}\n" for line in breaks),
+            end="",
+            file=sys.stderr,
+            flush=True,
+        )
 
 
 def run_launch(args, launch: str, launch_args, log: str, what: str):
@@ -157,7 +180,9 @@ def run_launch(args, launch: str, launch_args, log: str, what: str):
             raise
     wall = time.time() - start
     with open(log) as f:
-        return wall, f.read()
+        text = f.read()
+    warn_lockstep_breaks(lockstep_breaks(text), log)
+    return wall, text
 
 
 def report_json(report, as_built: str, world: str) -> dict:
@@ -208,6 +233,7 @@ def run(args) -> int:
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
     name = os.path.splitext(os.path.basename(model))[0]
+    breaks = []
     if args.bag:
         bag = os.path.abspath(args.bag)
         wall = None
@@ -215,7 +241,7 @@ def run(args) -> int:
         if shutil.which("roslaunch") is None:
             raise DriveError("roslaunch not found: source the workspace's devel/setup.bash")
         bag = os.path.join(out, "odometry_report.bag")
-        wall = drive(args, model, bag, args.manoeuvre)
+        wall, breaks = drive(args, model, bag, args.manoeuvre)
     # ROS's Python (rosbag, the calculators' plugin loader) only now: --help and bad robots stay fast
     from thorvald_base.plugins import load_calculator  # noqa: PLC0415
     from thorvald_base.verification import commanded_path, plan_named  # noqa: PLC0415
@@ -243,9 +269,10 @@ def run(args) -> int:
     if wall is not None:
         simulated = recording.states[-1][0] - recording.states[0][0]
         print(f"  drive: {simulated:.1f} s simulated in {wall:.1f} s wall, world {args.world}")
+        print(f"  lockstep: {'broken, this run may not repeat: ' + breaks[0] if breaks else 'kept throughout'}")
     if args.json:
         with open(args.json, "w") as f:
-            json.dump(report_json(report, args.as_built, args.world), f, indent=1)
+            json.dump({**report_json(report, args.as_built, args.world), "lockstep_breaks": breaks}, f, indent=1)
         print(f"  figures:  {os.path.abspath(args.json)}")
     print(f"  bag:      {bag}")
     print(f"  Figure 8: {figure8(report, os.path.join(out, 'figure8_paths.png'))}")

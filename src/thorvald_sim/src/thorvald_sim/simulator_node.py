@@ -104,6 +104,7 @@ from tf2_msgs.msg import TFMessage
 from thorvald_base import conversions
 from thorvald_base.publishing import NonBlockingPublisher, recorded_publisher
 from thorvald_base.rate_grid import RateGrid
+from thorvald_base.stamped_commands import LOCKSTEP_BROKEN
 from thorvald_model import ConfigError
 from thorvald_model.datum import load_datum
 from thorvald_msgs.msg import BaseState, DriveCurrents
@@ -437,9 +438,10 @@ class SimulatorNode:
         for name in self.waits.wait(rospy.is_shutdown):
             rospy.logwarn(
                 "simulator: %s did not answer its drive states for %.1f s: going on without it "
-                "(it joins lockstep again with its next command)",
+                "(%s; it joins lockstep again with its next command)",
                 name,
                 self.waits.timeout,
+                LOCKSTEP_BROKEN,
             )
 
     def wait_for_followers(self):
