@@ -30,6 +30,7 @@ class SimulatorParams:
     clock_rate: float = 80.0  # [Hz] of simulated time: every third step at 240 Hz physics
     odometry_rate: float = 50.0  # [Hz]
     drive_state_rate: float = 80.0  # [Hz]
+    drive_current_rate: float = 10.0  # [Hz]; in lockstep: with every drive_states
     command_timeout: float = 0.5  # [s]
     max_lag: float = 0.05  # [s]; 0: never wait for a lagging robot
     publish_tf: bool = True
@@ -62,6 +63,7 @@ class SimulatorParams:
             clock_rate=_number(get, "clock_rate", d.clock_rate),
             odometry_rate=_number(get, "odometry_rate", d.odometry_rate),
             drive_state_rate=_number(get, "drive_state_rate", d.drive_state_rate),
+            drive_current_rate=_number(get, "drive_current_rate", d.drive_current_rate),
             command_timeout=_number(get, "command_timeout", d.command_timeout),
             max_lag=_number(get, "max_lag", d.max_lag, allow_zero=True),
             publish_tf=bool(get("publish_tf", d.publish_tf)),

@@ -23,7 +23,9 @@ Private parameters:
 ``~clock_rate``           /clock messages per simulated second [Hz] (80: every third step at 240 Hz
                           physics; at most one a step)
 ``~odometry_rate``        odometry/gazebo and joint_states per simulated second [Hz] (50)
-``~drive_state_rate``     drive_states (and drive_currents) per simulated second [Hz] (80)
+``~drive_state_rate``     drive_states per simulated second [Hz] (80)
+``~drive_current_rate``   drive_currents per simulated second [Hz] (10: base_driver reports them at
+                          1 Hz; in lockstep they go with every drive_states, for the torque balance)
 ``~command_timeout``      a robot whose commands stop for this long [s] stops its wheels (0.5)
 ``~max_lag``              the simulator waits for a robot whose commands lag more than this behind
                           simulated time [s] (0.05; 0: never): a busy machine slows the
@@ -207,15 +209,16 @@ class RobotIO:
         self.odom_pub.publish(msg)
         return conversions.odometry_transform(msg) if self.publish_tf and tf_read else None
 
-    def publish_drives(self, stamp):
+    def publish_drives(self, stamp, states: bool = True, currents: bool = True):
+        """drive_currents and drive_states at stamp (those due), each if somebody reads it."""
         now = stamp.to_sec()
         # the currents first: a lockstep base_driver runs its cycle once the instant's states came
-        if self.current_pub.get_num_connections():
+        if currents and self.current_pub.get_num_connections():
             currents = self.robot.drive_currents(now)
             self.current_pub.publish(
                 conversions.currents_msg(stamp, [c[0] for c in currents], [c[1] for c in currents])
             )
-        if self.drive_pub.get_num_connections():  # base_driver with measured drives
+        if states and self.drive_pub.get_num_connections():  # base_driver with measured drives
             # its reader is there: in lockstep from its first drive states on, not its first answer
             if self.node.lockstep and self.node.waits.published(self.robot.name, now):
                 rospy.loginfo("simulator: %s in lockstep", self.robot.name)
@@ -257,6 +260,7 @@ class SimulatorNode:
         self.clock = RateGrid(params.clock_rate, self.sim.dt)
         self.odometry = RateGrid(params.odometry_rate, self.sim.dt)
         self.drives = RateGrid(params.drive_state_rate, self.sim.dt)
+        self.currents = RateGrid(params.drive_current_rate, self.sim.dt)
         # Written in the loop on non-blocking sockets (thorvald_base.publishing): a writer thread per reader
         # cost more than the physics; a blocking write froze the simulation when one reader's link dropped.
         self.clock_pub = NonBlockingPublisher("/clock", Clock)
@@ -469,9 +473,12 @@ class SimulatorNode:
         stamp = rospy.Time.from_sec(now)
         ticked = self.clock.due(now)
         drives = self.drives.due(now) if not self.lockstep else ticked
-        if drives:
+        # the currents cost a fleet more than their readers need (base_driver reports them once a second);
+        # in lockstep every instant's, for what a recorded drive balances (calibrate_odometry --balance)
+        currents = self.currents.due(now) if not self.lockstep else drives
+        if drives or currents:
             for io in self.io.values():
-                io.publish_drives(stamp)
+                io.publish_drives(stamp, drives, currents)
         if ticked:
             self.publish_clock()
         if self.odometry.due(now):

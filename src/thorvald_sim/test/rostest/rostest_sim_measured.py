@@ -10,11 +10,12 @@ At speed, base_driver's motor controllers report the simulated motors' currents 
 
 import unittest
 
+import numpy as np
 import rospy
 import rostest
 from sim_testing import Commander, Latest, delta, planar, sim_sleep
 
-from thorvald_msgs.msg import BaseState, ControllerArray
+from thorvald_msgs.msg import BaseState, ControllerArray, DriveCurrents
 
 
 class SimMeasuredTest(unittest.TestCase):
@@ -73,6 +74,23 @@ class SimMeasuredTest(unittest.TestCase):
         rospy.loginfo("tarmac: ground truth %.4f m, odometry %.4f m", truth[0], odom[0])
         self.assertGreater(truth[0], 9.0)  # about 10 m (a busy machine may start it late)
         self.assertAlmostEqual(odom[0], truth[0], delta=0.02 * truth[0])
+
+    def test_the_currents_come_at_their_own_rate_and_the_states_at_theirs(self):
+        # drive_currents at ~drive_current_rate (10 Hz: base_driver reports them at 1 Hz), drive_states at 80 Hz
+        stamps = {"drive_currents": [], "drive_states": []}
+        subs = [
+            rospy.Subscriber(f"/tarmac/{topic}", msg_type, lambda m, t=topic: stamps[t].append(m.header.stamp.to_sec()))
+            for topic, msg_type in (("drive_currents", DriveCurrents), ("drive_states", BaseState))
+        ]
+        sim_sleep(0.5)  # connected
+        start = rospy.get_time()
+        sim_sleep(2.5)
+        for sub in subs:
+            sub.unregister()
+        for topic, rate in (("drive_currents", 10.0), ("drive_states", 80.0)):
+            within = [t for t in stamps[topic] if start <= t < start + 2.0]
+            self.assertAlmostEqual(len(within), 2.0 * rate, delta=1, msg=topic)
+            self.assertAlmostEqual(float(np.median(np.diff(within))), 1.0 / rate, delta=0.2 / rate, msg=topic)
 
     def test_on_ice_ground_truth_falls_behind_odometry(self):
         truth, odom = self.drive("ice", 1.5)

@@ -159,7 +159,8 @@ def test_parameters_are_read_once_with_their_defaults():
     params = SimulatorParams.read(get)
     assert params == SimulatorParams(real_time_factor=0.0, seed=7, world="slope")
     assert params.clock_rate == 80.0 and params.publish_tf is True
-    assert len(asked) == len(set(asked)) == 18  # every parameter, each once
+    assert len(asked) == len(set(asked)) == 19  # every parameter, each once
+    assert (params.drive_state_rate, params.drive_current_rate) == (80.0, 10.0)
     assert (params.physics, params.physics_rate, params.solver_iterations) == ("default", 240.0, 50)
 
 
@@ -178,6 +179,7 @@ def test_the_physics_preset_gives_the_rate_and_iterations_unless_they_are_given(
         ("physics_rate", "fast", "must be a number"),
         ("physics_rate", True, "must be a number"),
         ("clock_rate", float("nan"), "must be > 0"),
+        ("drive_current_rate", 0, "must be > 0"),
         ("real_time_factor", -1, "must be >= 0"),
         ("seed", 1.5, "must be a whole number"),
         ("seed", True, "must be a whole number"),
