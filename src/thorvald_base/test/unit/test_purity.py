@@ -42,6 +42,7 @@ NOT_PURE = {
     "thorvald_sim.scene": "the simulator's physics (pybullet)",
     "thorvald_sim.robot": "the simulator's physics (pybullet)",
     "thorvald_sim.simulation": "the simulator's physics (pybullet)",
+    "thorvald_sim.workers": "the simulator's physics in worker processes (pybullet, through Simulation)",
     "thorvald_sim.runner": "drives a robot in the simulator without ROS (pybullet)",
     "thorvald_sim.run_robot": "the runner's command line (pybullet)",
     "thorvald_design.lab": "drives a design study's candidate in the simulator (pybullet)",

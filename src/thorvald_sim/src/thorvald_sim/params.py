@@ -11,10 +11,12 @@ Pure: no rospy.
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Tuple
 
 from .errors import ParameterError
 from .physics import PRESETS, physics_settings
+
+MAX_WORKERS = 16  # thorvald_sim.workers.MAX_WORKERS (which imports pybullet: this module stays pure)
 
 Getter = Callable[[str, Any], Any]
 
@@ -40,6 +42,8 @@ class SimulatorParams:
     seed: int = 0
     datum_file: str = ""
     lockstep: bool = False
+    physics_workers: int = 1  # 1: the node's own pybullet client; N >= 2: N worker processes (thorvald_sim.workers)
+    worker_strips: Tuple[float, ...] = ()  # [m] N - 1 increasing x: worker k takes spawn x in its strip
 
     @classmethod
     def read(cls, get: Getter) -> "SimulatorParams":
@@ -48,6 +52,15 @@ class SimulatorParams:
         seed = get("seed", d.seed)
         if isinstance(seed, bool) or not isinstance(seed, int):
             raise ParameterError(f"~seed: {seed!r}: must be a whole number")
+        gui = bool(get("gui", d.gui))
+        workers = get("physics_workers", d.physics_workers)
+        if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= MAX_WORKERS:
+            raise ParameterError(f"~physics_workers: {workers!r}: must be a whole number in 1..{MAX_WORKERS}")
+        if gui and workers > 1:
+            raise ParameterError(
+                f"~physics_workers: {workers!r}: must be 1 with ~gui true (pybullet's window shows one client's world)"
+            )
+        strips = _strips(get("worker_strips", d.worker_strips), workers)
         physics = get("physics", d.physics)
         try:  # unset: the preset's
             preset = physics_settings(physics, None, get("solver_iterations", None))
@@ -55,7 +68,7 @@ class SimulatorParams:
             raise ParameterError(f"~{e}") from None
         return cls(
             world=str(get("world", d.world)),
-            gui=bool(get("gui", d.gui)),
+            gui=gui,
             physics=physics,
             physics_rate=_number(get, "physics_rate", preset.rate),
             solver_iterations=preset.solver_iterations,
@@ -73,6 +86,8 @@ class SimulatorParams:
             seed=seed,
             datum_file=str(get("datum_file", d.datum_file) or ""),
             lockstep=bool(get("lockstep", d.lockstep)),
+            physics_workers=workers,
+            worker_strips=strips,
         )
 
 
@@ -87,3 +102,23 @@ def _number(get: Getter, name: str, default: float, allow_zero: bool = False) ->
     if not math.isfinite(number) or number < 0 or (number == 0 and not allow_zero):
         raise ParameterError(f"~{name}: {value!r}: must be {'>= 0' if allow_zero else '> 0'}")
     return number
+
+
+def _strips(value: Any, workers: int) -> Tuple[float, ...]:
+    """~worker_strips: a list of numbers, one number, or a text of numbers apart by spaces or commas
+    (roslaunch gives a launch argument's "9 18" as text); none, or workers - 1 increasing and finite."""
+    rule = f"must be none or {workers - 1} increasing x [m] (one between each two of ~physics_workers' strips)"
+    items = value
+    if isinstance(value, str):
+        items = value.replace(",", " ").split()
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        items = [value]
+    try:
+        strips = tuple(float(x) for x in items if not isinstance(x, bool))
+    except (TypeError, ValueError):
+        raise ParameterError(f"~worker_strips: {value!r}: {rule}") from None
+    if len(strips) != len(items) or not all(math.isfinite(x) for x in strips):
+        raise ParameterError(f"~worker_strips: {value!r}: {rule}")
+    if strips and (len(strips) != workers - 1 or any(b <= a for a, b in zip(strips, strips[1:]))):
+        raise ParameterError(f"~worker_strips: {value!r}: {rule}")
+    return strips

@@ -11,6 +11,12 @@ made: whatever its reading or its messages raise) is disabled, alone: the error 
 the robot, the sensor and its topics, and it stays on /diagnostics as an error from then on
 (:attr:`SensorIO.failure`, :meth:`RobotSensors.disabled`); the simulation, its clock and every
 other sensor and robot go on. Its topics stay advertised, silent, until the robot is deleted.
+
+A robot on a physics worker (:mod:`thorvald_sim.workers`) is measured where its physics is: the node
+asks which sensors have readers (:meth:`RobotSensors.requests`), the worker pauses the others'
+schedules and reads the due ones after its step, and the node makes and publishes the messages of
+what it read (:meth:`RobotSensors.publish_readings`), or disables a sensor whose reading failed there
+with the error's text. Such a sensor sees only its own worker's world (its robots, not the others').
 """
 
 import importlib
@@ -172,8 +178,13 @@ class SensorIO:
 
     def disable(self, now: float, error: BaseException) -> None:
         """This sensor is not read again: the error logged once, kept for /diagnostics."""
+        trace = "".join(traceback.format_exception(type(error), error, error.__traceback__))
+        self.failed(now, f"{type(error).__name__}: {error}", trace)
+
+    def failed(self, now: float, error: str, trace: str = "") -> None:
+        """disable with the error's type and text (a worker's reading fails in its process: its text comes back)."""
         spec = self.sensor.spec
-        what = f"{spec.describe()}: its reading failed: {type(error).__name__}: {error}"
+        what = f"{spec.describe()}: its reading failed: {error}"
         self.failure = DisabledSensor(spec.name, what, tuple(self.topics.values()), now)
         self.active = False
         self.keep.clear()  # a large frame's buffers go with it
@@ -182,7 +193,6 @@ class SensorIO:
             "simulator: %s: sensor %s (%s) disabled at %.3f s, the simulation goes on without it: %s",
             robot, spec.name, ", ".join(self.topics.values()), now, what,
         )  # fmt: skip
-        trace = "".join(traceback.format_exception(type(error), error, error.__traceback__))
         rospy.logdebug("simulator: %s: sensor %s: %s", robot, spec.name, trace)
 
     def _step(self, now: float, wanted: Dict[str, bool]) -> None:
@@ -196,9 +206,24 @@ class SensorIO:
             return
         start = time.thread_time()
         reading = self.sensor.read(now)
+        self._publish(now, reading, wanted)
+        self.cpu += time.thread_time() - start
+        self.readings += 1
+
+    def _publish(self, now: float, reading, wanted: Dict[str, bool]) -> None:
         for role, msg in self.messages(reading, rospy.Time.from_sec(now), wanted):
             self.pubs[role].publish(msg)
-        self.cpu += time.thread_time() - start
+
+    def publish_reading(self, now: float, reading, wanted: Dict[str, bool], cpu: float) -> None:
+        """A reading at now measured elsewhere (a physics worker: it cost cpu [s] there), published as
+        _step publishes its own; a message that fails disables the sensor, as in step."""
+        start = time.thread_time()
+        try:
+            self._publish(now, reading, wanted)
+        except Exception as e:  # whatever one sensor raises must not stop the simulation
+            self.disable(now, e)
+            return
+        self.cpu += cpu + time.thread_time() - start
         self.readings += 1
 
     def messages(self, reading, stamp, wanted):
@@ -260,11 +285,40 @@ class RobotSensors:
     def step(self, now: float) -> None:
         if not self.ios:
             return
+        self._check(now)
+        for io, wanted in zip(self.ios, self._wanted):
+            io.step(now, wanted)
+
+    def _check(self, now: float) -> None:
         if now - self._checked >= self.CHECK_PERIOD:
             self._checked = now
             self._wanted = [io.subscribed() for io in self.ios]
-        for io, wanted in zip(self.ios, self._wanted):
-            io.step(now, wanted)
+
+    # ---- a robot on a physics worker (thorvald_sim.workers): measured there, published here ----------
+    def requests(self, now: float) -> Tuple[int, ...]:
+        """Before a worker's step to simulated time now: the indices of the sensors to step with
+        readers (the worker pauses the others' schedules and reads these when due), as step decides."""
+        if not self.ios:
+            return ()
+        self._check(now)
+        wanted = []
+        for k, (io, roles) in enumerate(zip(self.ios, self._wanted)):
+            io.active = io.failure is None and any(roles.values())
+            if io.active:
+                wanted.append(k)
+        return tuple(wanted)
+
+    def publish_readings(self, now: float, results: Dict[int, tuple]) -> None:
+        """After the worker's step: each sensor's reading at now published, or its failure (the
+        error's text and trace from the worker) disabling it as a failed reading here would."""
+        for k, result in results.items():
+            io = self.ios[k]
+            if io.failure is not None:
+                continue
+            if result[0] == "failed":
+                io.failed(now, result[1], result[2])
+            else:
+                io.publish_reading(now, result[1], self._wanted[k], result[2])
 
     def uses(self) -> List[SensorUse]:
         """What each sensor read since the last call cost (sensors nobody reads are left out)."""

@@ -43,7 +43,23 @@ Private parameters:
                           description has neither a reference nor a datum of its own (none)
 ``~lockstep``             advance only when every robot's driver has answered the last instant's
                           drive states with its command (false; see below)
+``~physics_workers``      pybullet clients stepping the robots, each in a process of its own (1: the
+                          node's own client, as ever; 2..16: see below; 1 with ``~gui``)
+``~worker_strips``        with physics workers: the x [m] between each two workers' strips (N - 1
+                          increasing numbers, a list or a text "9 18"); a robot goes to the worker
+                          of its spawn x's strip (none: to the worker with the fewest robots)
 ========================  ================================================================
+
+Physics workers (``~physics_workers`` N >= 2, :mod:`thorvald_sim.workers`): N processes each hold
+the world's static scene and their share of the robots, and step at the same time, one round trip a
+physics step; the node keeps every robot's topics, services, frames, /clock, lockstep and sensors as
+with one client, and a robot's physics is the same to the bit. Robots on different workers cannot
+touch each other (nor see each other through a lidar or camera): two that come closer than their
+footprints allow are warned about and shown on /diagnostics. A worker that dies (killed, failed, or
+silent for 5 s of wall time) is logged with its robots and is an error for each on /diagnostics; its
+robots' topics go silent and lockstep lets them go, the others go on, and ``~delete_robot`` removes
+them. The workers' pids are the parameter ``~worker_pids`` and in /diagnostics; ``~snapshot`` draws
+the first live worker's world (it says so).
 
 Lockstep (``~lockstep`` true): with measured drives, the simulator publishes each robot's
 ``drive_states`` with every ``/clock`` tick and steps no further until that robot's base_driver
@@ -130,6 +146,7 @@ from .sensor_io import RobotSensors
 from .sensors import disabled_report, refused_sensors, sensor_report
 from .simulation import Camera, PerformanceMeter, Simulation, performance_report, save_png
 from .tf_watch import TfWatch
+from .workers import Reads, WorkerError, WorkerPool, WorldSettings
 from .world import load_world, resolve_world
 
 WARN_PERIOD = 5.0  # [s] between repeats of one warning
@@ -153,6 +170,7 @@ class RobotIO:
         self.current_pub = NonBlockingPublisher(ns + "drive_currents", DriveCurrents)
         self.commands = CommandSlot(len(robot.wheels))  # the latest, to apply in the loop
         self.node = node
+        self.alive = True  # False once its physics worker died: its topics go silent
         self.sub = rospy.Subscriber(ns + command_topic, BaseState, self.on_command, queue_size=1)
         self.passive = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
         self.passive_names = [info.name for _, info in robot.passive] + [s.joint for _, s in robot.springs]
@@ -180,13 +198,24 @@ class RobotIO:
         elif action == HOLD:
             self.robot.hold()
 
-    def publish_odometry(self, stamp, tf_read: bool):
-        """odometry/gazebo, joint_states of the passive joints: only what somebody reads; the transform of
-        odometry/gazebo for /tf if tf_read and this robot publishes it, else None."""
+    def reads(self, drives: bool, currents: bool, odometry: bool, tf_read: bool, now: float) -> Reads:
+        """On a physics worker: what to read of this robot after the step to now (what is due, and read)."""
+        return Reads(
+            states=drives and self.drive_pub.get_num_connections() > 0,
+            currents=currents and self.current_pub.get_num_connections() > 0,
+            odometry=odometry and bool(self.odom_pub.get_num_connections() or (self.publish_tf and tf_read)),
+            joints=odometry and bool(self.passive) and self.joint_pub.get_num_connections() > 0,
+            sensors=self.sensors.requests(now),
+        )
+
+    def publish_odometry(self, stamp, tf_read: bool, odometry: bool = True, joints: bool = True):
+        """odometry/gazebo, joint_states of the passive joints: only what somebody reads (and, on a
+        physics worker, what it read); the transform of odometry/gazebo for /tf if tf_read and this
+        robot publishes it, else None."""
         transform = None
-        if self.odom_pub.get_num_connections() or (self.publish_tf and tf_read):
+        if odometry and (self.odom_pub.get_num_connections() or (self.publish_tf and tf_read)):
             transform = self._publish_odometry(stamp, tf_read)
-        if self.passive and self.joint_pub.get_num_connections():
+        if joints and self.passive and self.joint_pub.get_num_connections():
             states = self.robot.joint_states(self.passive)
             self.joint_pub.publish(
                 conversions.joint_state_msg(stamp, self.passive_names, [s[0] for s in states], [s[1] for s in states])
@@ -246,11 +275,22 @@ class SimulatorNode:
         self.waits = Lockstep()  # lockstep: which robots the world waits for, for which instant
         self.pacer = Pacer(params.real_time_factor)
         self.followers = FollowerWait()  # without lockstep: robots whose commands lag ~max_lag behind
-        self.client = p.connect(p.GUI if self.gui else p.DIRECT)
-        self.sim = Simulation(
-            self.client, world, params.physics_rate, params.tyre_contact_width, seed=params.seed, datum=datum,
-            solver_iterations=params.solver_iterations,
-        )  # fmt: skip
+        self.pool = params.physics_workers > 1  # the robots on worker processes (thorvald_sim.workers)
+        self.worker_deaths = []  # thorvald_sim.workers.WorkerDeath of each worker that died, with its instant
+        self.too_close = []  # thorvald_sim.workers.TooClose at the last odometry tick
+        if self.pool:
+            self.client = None
+            settings = WorldSettings(
+                world, params.physics_rate, params.tyre_contact_width, params.seed, datum, params.solver_iterations
+            )
+            self.sim = WorkerPool(params.physics_workers, settings, params.worker_strips)
+            rospy.set_param("~worker_pids", self.sim.pids)
+        else:
+            self.client = p.connect(p.GUI if self.gui else p.DIRECT)
+            self.sim = Simulation(
+                self.client, world, params.physics_rate, params.tyre_contact_width, seed=params.seed, datum=datum,
+                solver_iterations=params.solver_iterations,
+            )  # fmt: skip
         self.physics = params.physics
         self.lock = threading.RLock()
         self.missing_meshes_said = set()  # mesh URIs warned about: once each, however many robots name them
@@ -289,6 +329,15 @@ class SimulatorNode:
             self.real_time_factor or "as fast as possible",
             ", paused" if self.paused else "",
         )
+        if self.pool:
+            rospy.loginfo(
+                "simulator: %d physics workers, pids %s, %s",
+                params.physics_workers,
+                " ".join(str(pid) for pid in self.sim.pids),
+                f"strips split at x = {', '.join(f'{x:g}' for x in params.worker_strips)} m"
+                if params.worker_strips
+                else "each robot to the worker with the fewest",
+            )
 
     # ---- services -------------------------------------------------------------------------
     def srv_pause(self, _req):
@@ -357,6 +406,8 @@ class SimulatorNode:
             message += f", {d.odometry_frame} -> {d.base_frame} on /tf from ground truth"
         if as_built is not None:
             message += f", as built: {as_built.source}"
+        if self.pool:
+            message += f", on physics worker {robot.worker}"
         rospy.loginfo("simulator: %s", message)
         return SpawnRobotResponse(True, message)
 
@@ -402,13 +453,22 @@ class SimulatorNode:
         if req.width or req.height:
             camera = Camera(camera.eye, camera.target, req.width or camera.width, req.height or camera.height)
         path = req.path or tempfile.mkstemp(prefix="thorvald_sim_", suffix=".png")[1]
+        whose = ""
         with self.lock:
-            image = self.sim.render(camera)
+            if self.pool:  # each worker holds its own robots: one world is drawn, and the answer says whose
+                try:
+                    image, worker = self.sim.render(camera)
+                except RuntimeError as e:
+                    return SnapshotResponse(False, str(e), "")
+                robots = [name for name, robot in self.sim.robots.items() if robot.worker == worker]
+                whose = f", the world of physics worker {worker} only (its robots: {', '.join(robots) or 'none'})"
+            else:
+                image = self.sim.render(camera)
         try:
             save_png(image, path)
         except OSError as e:
             return SnapshotResponse(False, f"{path}: {e.strerror}", "")
-        return SnapshotResponse(True, f"{camera.width} x {camera.height} px", os.path.abspath(path))
+        return SnapshotResponse(True, f"{camera.width} x {camera.height} px{whose}", os.path.abspath(path))
 
     # ---- the loop ---------------------------------------------------------------------------
     def publish_clock(self):
@@ -424,8 +484,11 @@ class SimulatorNode:
                     now = self.sim.time
                     for io in self.io.values():
                         io.apply(now, self.command_timeout)
-                    self.sim.step()
-                    ticked = self.publish(self.sim.time)
+                    if self.pool:
+                        ticked = self.step_workers()
+                    else:
+                        self.sim.step()
+                        ticked = self.publish(self.sim.time)
             if not paused and self.lockstep and ticked:
                 self.wait_for_answers()
             if self.meter is not None:
@@ -456,7 +519,7 @@ class SimulatorNode:
         def lagging():
             with self.lock:
                 now = self.sim.time
-                return [name for name, io in self.io.items() if io.commands.lagging(now, self.max_lag)]
+                return [name for name, io in self.io.items() if io.alive and io.commands.lagging(now, self.max_lag)]
 
         given_up = self.followers.wait(lagging, self.publish_clock, rospy.is_shutdown)
         if given_up:
@@ -467,21 +530,26 @@ class SimulatorNode:
                 self.max_lag,
             )
 
-    def publish(self, now: float) -> bool:
-        """What is due at simulated time now; whether /clock ticked. In lockstep the drive states go
-        with every tick, before it: a driver woken by the tick finds them."""
-        stamp = rospy.Time.from_sec(now)
+    def due(self, now: float):
+        """(clock, drive states, drive currents, odometry): what is due at simulated time now (each grid asked once)."""
         ticked = self.clock.due(now)
         drives = self.drives.due(now) if not self.lockstep else ticked
         # the currents cost a fleet more than their readers need (base_driver reports them once a second);
         # in lockstep every instant's, for what a recorded drive balances (calibrate_odometry --balance)
         currents = self.currents.due(now) if not self.lockstep else drives
+        return ticked, drives, currents, self.odometry.due(now)
+
+    def publish(self, now: float) -> bool:
+        """What is due at simulated time now; whether /clock ticked. In lockstep the drive states go
+        with every tick, before it: a driver woken by the tick finds them."""
+        stamp = rospy.Time.from_sec(now)
+        ticked, drives, currents, odometry = self.due(now)
         if drives or currents:
             for io in self.io.values():
                 io.publish_drives(stamp, drives, currents)
         if ticked:
             self.publish_clock()
-        if self.odometry.due(now):
+        if odometry:
             tf_read = self.tf.get_num_connections() > 0
             transforms = [io.publish_odometry(stamp, tf_read) for io in self.io.values()]
             transforms = [t for t in transforms if t is not None]
@@ -490,6 +558,64 @@ class SimulatorNode:
         for io in self.io.values():
             io.sensors.step(now)
         return ticked
+
+    def step_workers(self) -> bool:
+        """publish's twin with physics workers: what is due after the step is known before it, so each
+        worker reads it right after its step, at the instant the node's own client would be read; then
+        the same messages, in the same order. Whether /clock ticked."""
+        now = (self.sim.steps + 1) * self.sim.dt  # the instant after the step, as the pool computes it
+        ticked, drives, currents, odometry = self.due(now)
+        tf_read = odometry and self.tf.get_num_connections() > 0
+        live = [io for io in self.io.values() if io.alive]
+        reads = {io.robot.name: io.reads(drives, currents, odometry, tf_read, now) for io in live}
+        stamp = rospy.Time.from_sec(now)
+        # drive states and currents are asked at the stamp's instant, as publish_drives asks the node's client
+        for death in self.sim.step(reads, positions=odometry, stamped=stamp.to_sec()):
+            self.worker_died(death)
+        live = [io for io in live if io.alive]
+        if drives or currents:
+            for io in live:
+                got = io.robot.got
+                io.publish_drives(stamp, drives and got.states, currents and got.currents)
+        if ticked:
+            self.publish_clock()
+        if odometry:
+            transforms = [
+                io.publish_odometry(stamp, tf_read, io.robot.got.odometry, io.robot.got.joints) for io in live
+            ]
+            transforms = [t for t in transforms if t is not None]
+            if transforms:
+                self.tf.publish(TFMessage(transforms))
+            self.check_proximity()
+        for io in live:
+            io.sensors.publish_readings(now, io.robot.sensor_results)
+        return ticked
+
+    def worker_died(self, death) -> None:
+        """A physics worker died: said once with its robots, which go silent and leave lockstep."""
+        rospy.logerr(
+            "simulator: %s at %.3f s: its robots' topics go silent (delete them with ~delete_robot); "
+            "the other workers' robots go on",
+            death,
+            self.sim.time,
+        )
+        self.worker_deaths.append((death, self.sim.time))
+        for name in death.robots:
+            io = self.io.get(name)
+            if io is not None:
+                io.alive = False
+            self.waits.forget(name)
+
+    def check_proximity(self) -> None:
+        """At odometry ticks: robots on different workers closer than their footprints (they cannot touch)."""
+        self.too_close = self.sim.too_close()
+        for pair in self.too_close:
+            rospy.logwarn_throttle(
+                WARN_PERIOD,
+                "simulator: %s and %s are %.2f m apart, closer than %.2f m, on different physics workers "
+                "(%d and %d): they cannot touch each other",
+                pair.a, pair.b, pair.distance, pair.limit, self.sim.worker_of(pair.a), self.sim.worker_of(pair.b),
+            )  # fmt: skip
 
     # ---- other publishers of the robots' transforms ---------------------------------------------
     def watch_tf(self):
@@ -558,7 +684,8 @@ class SimulatorNode:
         robot goes without."""
         if not self.meter.due(wall):
             return
-        perf = self.meter.sample(wall, self.sim.time, time.process_time(), self.sim.solver_cpu)
+        cpu = time.process_time() + (self.sim.workers_cpu if self.pool else 0.0)  # the workers' processes too
+        perf = self.meter.sample(wall, self.sim.time, cpu, self.sim.solver_cpu)
         if perf is None:
             return
         asked = self.real_time_factor
@@ -577,7 +704,12 @@ class SimulatorNode:
         )  # fmt: skip
         simulation[2]["physics preset"] = self.physics
         simulation[2]["solver iterations"] = str(self.sim.solver_iterations)
+        if self.pool:
+            simulation[2]["physics workers"] = str(len(self.sim.workers))
+            simulation[2]["CPU"] = "the node's and its physics workers' processes"
         statuses = [conversions.diagnostic_status(rospy.get_name() + ": simulation", "pybullet", *simulation)]
+        if self.pool:
+            statuses += self.worker_statuses()
         statuses += [
             conversions.diagnostic_status(f"{rospy.get_name()}: sensors of {name}", name, *report)
             for name, report in sensor_reports
@@ -592,9 +724,42 @@ class SimulatorNode:
         msg.header.stamp = rospy.Time.from_sec(self.sim.time)
         self.diagnostics.publish(msg)
 
+    def worker_statuses(self):
+        """/diagnostics of the physics workers: one status with each worker's pid, robots and CPU (a
+        warning while robots on different workers are too close), and an error per robot whose worker died."""
+        node = rospy.get_name()
+        values = {"workers": str(len(self.sim.workers))}
+        for w in self.sim.workers:
+            state = "alive" if w.alive else "dead"
+            values[f"worker {w.index}"] = f"pid {w.pid}, {state}, robots: {', '.join(w.robots) or 'none'}"
+            values[f"worker {w.index} CPU [s]"] = f"{w.cpu:.3f}"
+        for pair in self.too_close:
+            values[f"{pair.a} and {pair.b}"] = f"{pair.distance:.2f} m apart, closer than {pair.limit:.2f} m"
+        level, message = 0, f"{len(self.sim.workers)} physics workers"
+        if self.too_close:
+            level = 1
+            message += "; robots on different workers too close to touch: " + ", ".join(
+                f"{pair.a} and {pair.b}" for pair in self.too_close
+            )
+        dead = [w for w in self.sim.workers if not w.alive]
+        if dead:
+            level = 2
+            message += "; dead: " + ", ".join(f"worker {w.index} (pid {w.pid})" for w in dead)
+        statuses = [conversions.diagnostic_status(f"{node}: physics workers", "pybullet", level, message, values)]
+        for death, since in self.worker_deaths:
+            for name in death.robots:
+                io = self.io.get(name)
+                if io is not None and not io.alive:  # not deleted since (nor spawned again, on another worker)
+                    why = f"{name}: {death} at {since:.3f} s; its topics are silent"
+                    values = {"robot": name, "worker": str(death.worker), "pid": str(death.pid), "why": death.reason}
+                    statuses.append(conversions.diagnostic_status(f"{node}: robot {name}", name, 2, why, values))
+        return statuses
+
     def shutdown(self):
         with self.lock:
-            if p.isConnected(self.client):
+            if self.pool:
+                self.sim.close()
+            elif p.isConnected(self.client):
                 p.disconnect(self.client)
 
 
@@ -607,6 +772,9 @@ def main():
         sys.exit(EXIT_REFUSED)
     except p.error as e:
         rospy.logfatal("simulator: refusing to start: pybullet: %s", e)
+        sys.exit(EXIT_REFUSED)
+    except WorkerError as e:
+        rospy.logfatal("simulator: refusing to start: %s", e)
         sys.exit(EXIT_REFUSED)
     try:
         node.spin()

@@ -7,6 +7,12 @@ r4 and r10 are never commanded. Then, mid-run, r2's base_driver process is kille
 goodbye, the simulator's command timeout has to stop it) and r8, one of fleet_driver's, is sent
 NaN commands, which its base_driver refuses: those two stop, every other robot drives on as
 commanded, and the two idle ones stay put.
+
+With physics workers (sim_fleet12_workers.test: the test node's ``~physics_workers`` 2, the simulator's
+strips split at x = 9), the same, and then worker 1 (its pid from the simulator's ``~worker_pids``),
+holding the robots at x 12 and 18, is killed: its robots' topics go silent, the other worker's
+robots drive on as commanded, the simulator reports the death on /diagnostics, and one of the dead
+worker's robots is deleted.
 """
 
 import math
@@ -21,14 +27,32 @@ import rosgraph
 import rosnode
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Twist
 from sim_testing import Latest, planar, sim_sleep
+
+from thorvald_msgs.srv import DeleteRobot
 
 ROBOTS = [f"r{k}" for k in range(12)]
 IDLE = ("r4", "r10")
 KILLED = "r2"  # its own base_driver process, killed
 REFUSED = "r8"  # fleet_driver's, sent NaN commands
 PHASE = 4.0  # [s] simulated, each phase
+STRIP = 9.0  # [m] with physics workers: worker 0 holds the robots at x 0 and 6, worker 1 those at 12 and 18
+AFTER_KILL = 2.0  # [s] simulated
+DELETED = "r3"  # a robot of the killed worker, deleted after its death
+TOUCHING = 2.5  # [m] between two standard robots' base_links: their frames may touch
+DIAGNOSTICS_WAIT = 30.0  # [s] wall, for /diagnostics (1 Hz of wall time) to report the dead worker
+
+
+def spawn_x(robot):
+    """[m] the robot's spawn x in sim_fleet12.test: 0, 6, 12, 18 along each row."""
+    return 6.0 * (ROBOTS.index(robot) % 4)
+
+
+def in_world(robot, pose):
+    """(x, y) [m] in the world of a pose in the robot's odom frame (its spawn pose, heading along x)."""
+    return spawn_x(robot) + pose[0], 6.0 * (ROBOTS.index(robot) // 4) + pose[1]
 
 
 def twist_of(k):
@@ -68,6 +92,32 @@ def speeds(truth):
     """(speed [m/s], yaw rate [rad/s]) of the latest ground truth."""
     t = truth.get().twist.twist
     return math.hypot(t.linear.x, t.linear.y), t.angular.z
+
+
+class SimulatorDiagnostics:
+    """The simulator's latest /diagnostics status of each name (other nodes publish there too)."""
+
+    def __init__(self):
+        self.statuses = {}
+        self.lock = threading.Lock()
+        self.sub = rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=10)
+
+    def on_diagnostics(self, msg):
+        with self.lock:
+            for status in msg.status:
+                if status.name.startswith("/simulator: "):
+                    self.statuses[status.name] = status
+
+    def wait_for(self, name, level):
+        """The status name once it has level (within DIAGNOSTICS_WAIT of wall time)."""
+        deadline = time.time() + DIAGNOSTICS_WAIT
+        while time.time() < deadline and not rospy.is_shutdown():
+            with self.lock:
+                status = self.statuses.get(name)
+            if status is not None and status.level == level:
+                return status
+            time.sleep(0.1)
+        raise AssertionError(f"no {name} of level {level} on /diagnostics; last: {status}")
 
 
 def kill_process_of(node):
@@ -149,6 +199,77 @@ class SimFleet12Test(unittest.TestCase):
                     self.check_as_commanded(r, self.second[r])
 
 
+class SimFleet12WorkersTest(SimFleet12Test):
+    """sim_fleet12_workers.test: the same, the physics in two workers; then worker 1 is killed."""
+
+    @classmethod
+    def setUpClass(cls):
+        super().setUpClass()
+        # Worker 1 (x >= STRIP) killed mid-drive: its robots' topics go silent, worker 0's drive on
+        cls.diagnostics = SimulatorDiagnostics()
+        cls.dead = [r for r in ROBOTS if spawn_x(r) >= STRIP]
+        cls.worker_pid = rospy.get_param("/simulator/worker_pids")[1]
+        cls.before_kill = {r: planar(cls.truth[r].get()) for r in ROBOTS}
+        cls.killed_at = rospy.get_time()
+        os.kill(cls.worker_pid, signal.SIGKILL)
+        sim_sleep(AFTER_KILL)
+        cls.after_kill = {r: planar(cls.truth[r].get()) for r in ROBOTS}
+        cls.heard = {r: cls.truth[r].get().header.stamp.to_sec() for r in ROBOTS}
+        cls.checked_at = rospy.get_time()
+        # the death on /diagnostics (read here: a robot deleted below leaves it), then a dead robot deleted
+        try:
+            cls.workers_status = cls.diagnostics.wait_for("/simulator: physics workers", 2)
+            cls.robot_statuses = {r: cls.diagnostics.wait_for(f"/simulator: robot {r}", 2) for r in cls.dead}
+        except AssertionError as e:
+            cls.workers_status, cls.robot_statuses = None, str(e)
+        cls.deleted = rospy.ServiceProxy("/simulator/delete_robot", DeleteRobot)(model_name=DELETED)
+
+    def test_a_killed_physics_worker_silences_only_its_robots(self):
+        self.assertEqual(sorted(self.dead), ["r10", "r11", "r2", "r3", "r6", "r7"])
+        for r in ROBOTS:
+            with self.subTest(robot=r):
+                rospy.loginfo(
+                    "%s: last ground truth at %.3f s (worker killed at %.3f s)", r, self.heard[r], self.killed_at
+                )
+                if r in self.dead:
+                    self.assertLess(self.heard[r], self.killed_at + 0.5, f"{r} still heard after its worker died")
+                else:
+                    self.assertGreater(self.heard[r], self.checked_at - 0.5, f"{r} went silent")
+        live = [r for r in ROBOTS if r not in self.dead]
+        checked = []
+        for r in live:
+            # r1 and r5 circle towards each other, and meet about now: a robot that touches another is left out
+            here = in_world(r, self.after_kill[r])
+            touching = [o for o in live if o != r and math.dist(here, in_world(o, self.after_kill[o])) < TOUCHING]
+            if r not in (*IDLE, KILLED, REFUSED) and not touching:
+                with self.subTest(robot=r):
+                    vx, _ = twist_of(ROBOTS.index(r))
+                    start, end = self.before_kill[r], self.after_kill[r]
+                    moved = math.hypot(end[0] - start[0], end[1] - start[1])
+                    rospy.loginfo(
+                        "%s: %.3f m in %.1f s after the worker died (commanded %.2f m/s)", r, moved, AFTER_KILL, vx
+                    )
+                    self.assertGreater(moved, 0.9 * vx * AFTER_KILL, f"{r} stopped with the other worker")
+                    checked.append(r)
+        self.assertGreaterEqual(len(checked), 2, "too few robots free to drive to judge")
+
+    def test_a_killed_physics_worker_is_reported_on_diagnostics(self):
+        self.assertIsNotNone(self.workers_status, self.robot_statuses)
+        self.assertIn(f"worker 1 (pid {self.worker_pid})", self.workers_status.message)
+        for r in self.dead:
+            with self.subTest(robot=r):
+                robot = self.robot_statuses[r]
+                self.assertIn("physics worker 1", robot.message)
+                self.assertIn("killed by signal 9", robot.message)
+
+    def test_a_robot_of_a_dead_worker_can_be_deleted(self):
+        self.assertTrue(self.deleted.success, self.deleted.message)
+        self.assertEqual(self.deleted.message, f"deleted {DELETED}")
+
+
 if __name__ == "__main__":
     rospy.init_node("sim_fleet12_test")
-    rostest.rosrun("thorvald_sim", "sim_fleet12", SimFleet12Test)
+    if rospy.get_param("~physics_workers", 1) > 1:
+        rostest.rosrun("thorvald_sim", "sim_fleet12_workers", SimFleet12WorkersTest)
+    else:
+        rostest.rosrun("thorvald_sim", "sim_fleet12", SimFleet12Test)

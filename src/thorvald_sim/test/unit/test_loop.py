@@ -159,7 +159,7 @@ def test_parameters_are_read_once_with_their_defaults():
     params = SimulatorParams.read(get)
     assert params == SimulatorParams(real_time_factor=0.0, seed=7, world="slope")
     assert params.clock_rate == 80.0 and params.publish_tf is True
-    assert len(asked) == len(set(asked)) == 19  # every parameter, each once
+    assert len(asked) == len(set(asked)) == 21  # every parameter, each once
     assert (params.drive_state_rate, params.drive_current_rate) == (80.0, 10.0)
     assert (params.physics, params.physics_rate, params.solver_iterations) == ("default", 240.0, 50)
 
@@ -187,6 +187,11 @@ def test_the_physics_preset_gives_the_rate_and_iterations_unless_they_are_given(
         ("physics", ["fleet"], "must be one of default, fleet"),
         ("solver_iterations", 0, "must be a whole number in 1..1000"),
         ("solver_iterations", 12.5, "must be a whole number in 1..1000"),
+        ("physics_workers", 0, "must be a whole number in 1..16"),
+        ("physics_workers", 17, "must be a whole number in 1..16"),
+        ("physics_workers", True, "must be a whole number in 1..16"),
+        ("physics_workers", 2.0, "must be a whole number in 1..16"),
+        ("worker_strips", "9", "must be none or 0 increasing x [m]"),
     ],
 )
 def test_a_bad_parameter_is_refused_with_its_name_value_and_rule(name, value, rule):
@@ -194,6 +199,30 @@ def test_a_bad_parameter_is_refused_with_its_name_value_and_rule(name, value, ru
         SimulatorParams.read(lambda n, d: value if n == name else d)
     assert str(e.value).startswith(f"~{name}: {value!r}: {rule}")
     assert isinstance(e.value, ThorvaldSimError)
+
+
+@pytest.mark.parametrize(
+    "strips, read",
+    [("", ()), ("9", (9.0,)), (9, (9.0,)), ("-3, 9.5", (-3.0, 9.5)), ([0, 10], (0.0, 10.0)), ("9 x", None),
+     ("9 3", None), ([1, float("nan")], None), ([True, 3], None), ("1 2 3", None)],
+)  # fmt: skip
+def test_physics_workers_take_strips_of_one_less_increasing_x(strips, read):
+    workers = 2 if len(read or ()) < 2 else 3
+    given = {"physics_workers": workers, "worker_strips": strips}
+    if read is None:
+        with pytest.raises(ParameterError) as e:
+            SimulatorParams.read(given.get)
+        assert str(e.value).startswith(f"~worker_strips: {strips!r}: must be none or {workers - 1} increasing x [m]")
+    else:
+        params = SimulatorParams.read(given.get)
+        assert (params.physics_workers, params.worker_strips) == (workers, read)
+
+
+def test_pybullets_window_shows_one_client_so_gui_takes_one_worker():
+    with pytest.raises(ParameterError) as e:
+        SimulatorParams.read({"gui": True, "physics_workers": 2}.get)
+    assert str(e.value) == "~physics_workers: 2: must be 1 with ~gui true (pybullet's window shows one client's world)"
+    assert SimulatorParams.read({"gui": True}.get).physics_workers == 1
 
 
 # ---- commands ------------------------------------------------------------------------------------
