@@ -2,7 +2,8 @@
 """Fleets in one simulation: the largest fleet this machine holds at real time, and where the CPU goes.
 
     python bench/fleet.py [--seconds 60] [--robots 4 8 12 16 20] [--lidar-robots 4 8 12]
-                          [--stacks per-robot fleet] [--physics default fleet] [--plot docs/images/fleet/rtf.png]
+                          [--stacks per-robot fleet] [--physics default fleet] [--workers 1 2]
+                          [--plot docs/images/fleet/rtf.png]
 
 Each case is one roslaunch on the benchmark's own master: simulator.launch at real time
 (real_time_factor 1) in the flat world, and N standard robots (thorvald_ii_4wd4ws_std) brought up
@@ -18,15 +19,27 @@ Stacks: ``per-robot`` is the stack as it is (base_driver and twist_mux processes
 (``fleet_driver:=true``), the same topics, services and parameters per robot. ``--physics`` runs
 each stack with each physics preset (simulator.launch's ``physics``: ``default``, or ``fleet``: 120
 Hz, about half the solver's CPU); a stack on a preset other than the default is labelled
-``STACK+PRESET``.
+``STACK+PRESET``. ``--workers`` runs each of them with each number of physics worker processes
+(simulator.launch's ``physics_workers``), labelled ``STACK+wN`` for N > 1.
 
 Figures per case, over ``--seconds`` simulated seconds after 5 s of warm-up:
 - real-time factor (simulated seconds per wall second); held: at least 0.95;
 - the CPU per robot and simulated second [ms] of each part: pybullet's solver (the simulator's own
-  /diagnostics: the thread CPU clock around stepSimulation), the simulator's ROS and Python work
-  (its process's CPU less the solver), base_driver, twist_mux (or the fleet_driver holding both),
+  /diagnostics: the thread CPU clock around stepSimulation, in every worker), the simulator's ROS
+  and Python work (its process's CPU less the solver), its physics workers' other work (their
+  processes' CPU less the solver), base_driver, twist_mux (or the fleet_driver holding both),
   robot_state_publisher, the ROS master, the rest (the world -> odom publishers); and the whole
-  stack's against the solver's.
+  stack's against the solver's;
+- raw pybullet beside it: the same number of standard robots stepped by pybullet alone in this
+  process (the simulator's Simulation class builds the world, then bare stepSimulation at the
+  preset's rate, 10 simulated seconds), and the simulator's CPU (node, workers, solver) against it.
+
+A projection per stack: the fleet a machine of 8 and 16 cores would hold at real time, from the
+largest fleet measured without lidars. Its assumptions: the CPU per robot of each part stays what
+it was here; the simulator node's own thread (its ROS work, and the physics too without workers: one
+core at most, Python's interpreter lock) and each process of the stack may use at most 0.9 of a
+core; there are as many workers and fleet_drivers as needed; the whole stack fits in 0.9 of the
+cores.
 
 Targets (issue 24): the whole stack's CPU at most 3 times the solver's; 20 robots held at real
 time; 12 robots with a lidar each held; the simulator node's own CPU at most 1.3 times its solver's.
@@ -37,6 +50,7 @@ interpreter lock) and the whole stack's against the machine's cores.
 
 import argparse
 import json
+import math
 import os
 import re
 import signal
@@ -56,11 +70,25 @@ SPACING = 6.0  # [m] between robots: circles of 1 to 1.3 m radius never meet
 HELD = 0.95
 WARM_UP = 5.0  # [s] simulated
 COMMAND_PERIOD = 0.1  # [s]
-ROLES = ("solver", "simulator", "base_driver", "twist_mux", "fleet_driver", "robot_state_publisher", "master", "rest")
+ROLES = (
+    "solver",
+    "simulator",
+    "workers",
+    "base_driver",
+    "twist_mux",
+    "fleet_driver",
+    "robot_state_publisher",
+    "master",
+    "rest",
+)
 TARGET_STACK = 3.0
 TARGET_FLEET = 20
 TARGET_LIDAR_FLEET = 12
 TARGET_SIMULATOR = 1.3
+TARGET_WORKER_FLEET = 24  # with physics workers (issue 35)
+PROJECTED_CORES = (8, 16)
+CORE_USE = 0.9  # of a core a process, and of the machine the whole stack, in the projection
+RAW_SECONDS = 10.0  # [s] simulated of raw pybullet per fleet size
 
 
 def grid(k, n):
@@ -73,7 +101,7 @@ def twist_of(k):
     return 0.30 + 0.02 * (k % 5), 0.3 if k % 2 else -0.3
 
 
-def launch_file(n: int, lidar: bool, stack: str, rtf: float = 1.0, physics: str = "default"):
+def launch_file(n: int, lidar: bool, stack: str, rtf: float = 1.0, physics: str = "default", *, workers: int = 1):
     extras = f'<arg name="model_extras" value="{LIDAR}"/>' if lidar else ""
     robots = "\n".join(
         f'  <include file="$(find thorvald_bringup)/launch/sim_robot_in_world.launch"><arg name="ns" value="r{k}"/>'
@@ -91,33 +119,88 @@ def launch_file(n: int, lidar: bool, stack: str, rtf: float = 1.0, physics: str 
     return (
         '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'
         f'<arg name="world" value="flat"/><arg name="real_time_factor" value="{rtf:g}"/>'
-        f'<arg name="physics" value="{physics}"/><arg name="output" value="log"/>'
+        f'<arg name="physics" value="{physics}"/><arg name="physics_workers" value="{workers}"/>'
+        '<arg name="output" value="log"/>'
         f"</include>\n{robots}\n{fleet}</launch>\n"
     )
 
 
-def role_of(pid: int, master_pid: int) -> str:
+def role_of(pid: int, master_pid: int, parent: str = "") -> str:
+    """A process's part: the node it is (its __name:=), the master, a physics worker (a process the
+    simulator started), or the rest."""
     if pid == master_pid:
         return "master"
     match = re.search(r"__name:=(\S+)", cmdline(pid))
     name = match.group(1) if match else ""
     if name in ROLES:
         return name
-    return "rest"
+    return "workers" if parent in ("simulator", "workers") else "rest"
 
 
-def cpu_by_role(pids, master_pid):
+def processes(root: int, master_pid: int):
+    """{pid: role} of every descendant of root (the launch) and the master."""
+    roles = {master_pid: "master"}
+    todo = [(pid, "") for pid in children(root)]
+    while todo:
+        pid, parent = todo.pop()
+        roles[pid] = role_of(pid, master_pid, parent)
+        todo += [(child, roles[pid]) for child in children(pid)]
+    return roles
+
+
+def cpu_by_role(roles):
     totals = dict.fromkeys(ROLES, 0.0)
-    for pid in pids:
-        totals[role_of(pid, master_pid)] += cpu_seconds(pid, missing=0.0)
+    for pid, role in roles.items():
+        totals[role] += cpu_seconds(pid, missing=0.0)
     return totals
+
+
+def raw_pybullet(n: int, physics: str, seconds: float = RAW_SECONDS) -> float:
+    """CPU [s] per robot and simulated second of bare pybullet stepping n standard robots (6 m apart,
+    commanded 0.3 m/s) at the preset's rate and iterations, in this process: the world built by the
+    simulator's Simulation class."""
+    import pybullet as p  # noqa: PLC0415
+
+    from thorvald_model.description import generate_urdf  # noqa: PLC0415
+    from thorvald_sim.physics import physics_settings  # noqa: PLC0415
+    from thorvald_sim.robot import Pose2D  # noqa: PLC0415
+    from thorvald_sim.simulation import Simulation  # noqa: PLC0415
+    from thorvald_sim.world import load_world, resolve_world  # noqa: PLC0415
+
+    settings = physics_settings(physics, None, None)
+    urdf = generate_urdf(STD)
+    client = p.connect(p.DIRECT)
+    try:
+        sim = Simulation(
+            client, load_world(resolve_world("flat")), settings.rate, solver_iterations=settings.solver_iterations
+        )
+        for k in range(n):
+            sim.spawn(f"r{k}", urdf, Pose2D(*grid(k, n), 0.0)).command([0.0] * 4, [0.3] * 4)
+        for _ in range(round(settings.rate)):  # under way
+            sim.step()
+        cpu = time.process_time()
+        for _ in range(round(seconds * settings.rate)):
+            p.stepSimulation(physicsClientId=client)
+        return (time.process_time() - cpu) / seconds / n
+    finally:
+        p.disconnect(client)
 
 
 def _ignore(_msg):
     pass
 
 
-def case(n: int, lidar: bool, stack: str, seconds: float, *, master, rtf: float = 1.0, physics: str = "default"):
+def case(
+    n: int,
+    lidar: bool,
+    stack: str,
+    seconds: float,
+    *,
+    master,
+    rtf: float = 1.0,
+    physics: str = "default",
+    workers: int = 1,
+):
     """{figure: value} of one fleet, on the benchmark's master."""
     import rospy  # noqa: PLC0415
     from diagnostic_msgs.msg import DiagnosticArray  # noqa: PLC0415
@@ -127,7 +210,7 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master, rtf: float 
 
     from thorvald_testing.topics import Latest  # noqa: PLC0415
 
-    xml = launch_file(n, lidar, stack, rtf, physics)
+    xml = launch_file(n, lidar, stack, rtf, physics, workers=workers)
     clock = Latest("/clock", Clock, queue_size=1)
     solver = []  # the simulator's figure per /diagnostics window while measuring [s per simulated s]
     measuring = threading.Event()
@@ -195,22 +278,23 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master, rtf: float 
                 sub.unregister()
             start = now()
             poll(lambda: check(launch, label) or now() - start >= WARM_UP, 20 * WARM_UP, f"{label}: the warm-up")
-            pids = [*children(launch.proc.pid), master.proc.pid]
-            t0, w0, c0 = now(), time.perf_counter(), cpu_by_role(pids, master.proc.pid)
+            roles = processes(launch.proc.pid, master.proc.pid)
+            t0, w0, c0 = now(), time.perf_counter(), cpu_by_role(roles)
             measuring.set()
             while now() - t0 < seconds:
                 check(launch, label)
                 if time.perf_counter() - w0 > 20 * seconds:
                     raise RuntimeError(f"{label}: {now() - t0:.1f} simulated s in {20 * seconds:.0f} wall s")
                 time.sleep(0.1)
-            t1, w1, c1 = now(), time.perf_counter(), cpu_by_role(pids, master.proc.pid)
+            t1, w1, c1 = now(), time.perf_counter(), cpu_by_role(roles)
             measuring.clear()
             if not solver:
                 raise RuntimeError(f"{label}: no /diagnostics from the simulator while measuring")
             simulated = t1 - t0
             per_robot = {role: (c1[role] - c0[role]) / simulated / n for role in ROLES}
             per_robot["solver"] = sum(solver) / len(solver) / n
-            per_robot["simulator"] -= per_robot["solver"]  # the simulator process's CPU less its solver
+            # the solver's CPU is in the processes that step: the simulator's, or its workers'
+            per_robot["workers" if workers > 1 else "simulator"] -= per_robot["solver"]
             return {"rtf": simulated / (w1 - w0), "wall": w1 - w0, **per_robot}
     finally:
         stop.set()
@@ -218,13 +302,19 @@ def case(n: int, lidar: bool, stack: str, seconds: float, *, master, rtf: float 
             endpoint.unregister()
 
 
+def simulator_cpu(r) -> float:
+    """The simulator's whole CPU per robot and simulated second [s]: its node, its workers, the solver."""
+    return r["solver"] + r["simulator"] + r.get("workers", 0.0)
+
+
 def print_row(n, lidar, stack, r):
-    ms = {role: 1000 * r[role] for role in ROLES}
+    ms = {role: 1000 * r.get(role, 0.0) for role in ROLES}
     total = sum(ms.values())
+    raw = f" {1000 * r['raw']:>7.1f} {simulator_cpu(r) / r['raw']:>7.2f}x" if "raw" in r else ""
     print(
-        f"{n:>6} {'yes' if lidar else 'no':>5} {stack:>13} {r['rtf']:>6.2f}{'' if r['rtf'] >= HELD else '*':1}"
+        f"{n:>6} {'yes' if lidar else 'no':>5} {stack:>16} {r['rtf']:>6.2f}{'' if r['rtf'] >= HELD else '*':1}"
         + "".join(f" {ms[role]:>8.1f}" for role in ROLES)
-        + f" {total:>7.1f} {total / ms['solver']:>7.1f}x {(ms['simulator'] + ms['solver']) / ms['solver']:>7.2f}x",
+        + f" {total:>7.1f} {total / ms['solver']:>7.1f}x {1000 * simulator_cpu(r) / ms['solver']:>7.2f}x{raw}",
         flush=True,
     )
 
@@ -238,7 +328,7 @@ def plot(results, path):
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
     for (lidar, stack), points in sorted(results.items()):
         xs = sorted(points)
-        ax.plot(xs, [points[x]["rtf"] for x in xs], "o-", label=f"{stack} stack{', lidar each' if lidar else ''}")
+        ax.plot(xs, [points[x]["rtf"] for x in xs], "o-", label=f"{describe(stack)}{', lidar each' if lidar else ''}")
     ax.axhline(HELD, color="grey", linestyle="--", linewidth=1)
     ax.text(ax.get_xlim()[0], HELD, " held at real time (0.95)", va="bottom", color="grey", fontsize=8)
     ax.set_xlabel("robots (thorvald_ii_4wd4ws_std, full stack each)")
@@ -259,6 +349,7 @@ def main() -> int:
     parser.add_argument("--lidar-robots", type=int, nargs="*", default=[4, 8, 12], help="fleet sizes with a lidar each")
     parser.add_argument("--stacks", nargs="+", default=["per-robot", "fleet"], choices=["per-robot", "fleet"])
     parser.add_argument("--physics", nargs="+", default=["default"], choices=["default", "fleet"])
+    parser.add_argument("--workers", type=int, nargs="+", default=[1], help="physics worker processes (1: none)")
     parser.add_argument(
         "--real-time-factor", type=float, default=1.0, help="the simulator's pace (1; 0: as fast as it can)"
     )
@@ -270,9 +361,9 @@ def main() -> int:
     cases = [(n, False) for n in args.robots] + [(n, True) for n in args.lidar_robots]
     print("CPU per robot and simulated second [ms]; * below 0.95 of real time")
     print(
-        f"{'robots':>6} {'lidar':>5} {'stack':>13} {'RTF':>7}"
+        f"{'robots':>6} {'lidar':>5} {'stack':>16} {'RTF':>7}"
         + "".join(f" {role[:8]:>8}" for role in ROLES)
-        + f" {'total':>7} {'/solver':>8} {'sim/solv':>8}"
+        + f" {'total':>7} {'/solver':>8} {'sim/solv':>8} {'raw':>7} {'sim/raw':>8}"
     )
     results = {}
     if args.merge:
@@ -280,14 +371,24 @@ def main() -> int:
             for row in json.load(f):
                 results.setdefault((row["lidar"], row["stack"]), {})[row["robots"]] = row["figures"]
                 print_row(row["robots"], row["lidar"], row["stack"], row["figures"])
+    raw = {}  # (robots, physics): raw pybullet's CPU per robot and simulated second
     with ros_session("bench_fleet", core_only=True) as (master, _):
         for n, lidar in cases:
             for stack in args.stacks:
                 for physics in args.physics:
-                    r = case(n, lidar, stack, args.seconds, master=master, rtf=args.real_time_factor, physics=physics)
-                    label = stack if physics == "default" else f"{stack}+{physics}"
-                    results.setdefault((lidar, label), {})[n] = r
-                    print_row(n, lidar, label, r)
+                    if not lidar and (n, physics) not in raw:  # between the launches: nothing else runs
+                        raw[n, physics] = raw_pybullet(n, physics)
+                    for workers in args.workers:
+                        r = case(
+                            n, lidar, stack, args.seconds, master=master, rtf=args.real_time_factor, physics=physics,
+                            workers=workers,
+                        )  # fmt: skip
+                        if not lidar:
+                            r["raw"] = raw[n, physics]
+                        label = stack + (f"+{physics}" if physics != "default" else "")
+                        label += f"+w{workers}" if workers > 1 else ""
+                        results.setdefault((lidar, label), {})[n] = r
+                        print_row(n, lidar, label, r)
     if args.json:
         rows = [
             {"robots": n, "lidar": lidar, "stack": stack, "figures": r}
@@ -298,7 +399,10 @@ def main() -> int:
             json.dump(rows, f, indent=1)
     if args.plot:
         plot(results, args.plot)
-    return 0 if verdicts(results) else 1
+    ok = verdicts(results)
+    for line in projections(results):
+        print(line)
+    return 0 if ok else 1
 
 
 def verdicts(results) -> bool:
@@ -313,11 +417,12 @@ def verdicts(results) -> bool:
     for stack in sorted({s for _, s in results}):
         every = [r for (_, s), points in results.items() if s == stack for r in points.values()]
         stack_ratio = max(sum(r[role] for role in ROLES) / r["solver"] for r in every)
-        sim_ratio = max((r["simulator"] + r["solver"]) / r["solver"] for r in every)
+        sim_ratio = max(simulator_cpu(r) / r["solver"] for r in every)
         held, held_lidar = largest_held(False, stack), largest_held(True, stack)
+        fleet = TARGET_WORKER_FLEET if "+w" in stack else TARGET_FLEET
         checks = [
             (f"whole stack's CPU at most {TARGET_STACK:g} x the solver's", stack_ratio <= TARGET_STACK, stack_ratio),
-            (f"{TARGET_FLEET} robots held at real time", held >= TARGET_FLEET, held),
+            (f"{fleet} robots held at real time", held >= fleet, held),
             (f"{TARGET_LIDAR_FLEET} robots with a lidar each held", held_lidar >= TARGET_LIDAR_FLEET, held_lidar),
             (
                 f"simulator node's CPU at most {TARGET_SIMULATOR:g} x its solver's",
@@ -338,18 +443,72 @@ def verdicts(results) -> bool:
     return ok
 
 
+def projections(results) -> list:
+    """Lines: for each stack, the fleet a machine of PROJECTED_CORES would hold at real time, from its
+    largest fleet measured without lidars (see the module's docstring)."""
+    lines = []
+    for (lidar, stack), points in sorted(results.items()):
+        if lidar or not points:
+            continue
+        held = [k for k, r in points.items() if r["rtf"] >= HELD]
+        n = max(held or points)  # the largest held: a fleet that fell behind measures a saturated machine
+        r = points[n]
+        per_robot = sum(r.get(role, 0.0) for role in ROLES)
+        workers = "+w" in stack
+        # the node's own thread: its ROS messages and loop, and the physics too unless workers step it
+        node = r["simulator"] if workers else r["simulator"] + r["solver"]
+        physics = r["solver"] + r.get("workers", 0.0) if workers else 0.0
+        driver = r.get("fleet_driver", 0.0)
+        lines.append(
+            f"projection from {stack}, {n} robots at {r['rtf']:.2f} of real time ({1000 * per_robot:.1f} ms a robot "
+            f"and simulated second: node {1000 * node:.1f}, physics {1000 * physics:.1f}, fleet_driver "
+            f"{1000 * driver:.1f}):"
+        )
+        by_node = CORE_USE / node
+        for cores in PROJECTED_CORES:
+            by_cores = CORE_USE * cores / per_robot
+            robots = int(min(by_node, by_cores))
+            bound = "the simulator node's thread" if by_node < by_cores else f"{cores} cores"
+            count = math.ceil(robots * physics / CORE_USE)
+            needed = f"{count} worker{'s' if count != 1 else ''}" if workers else "the physics in the node"
+            drivers = math.ceil(robots * driver / CORE_USE) if driver else 0
+            lines.append(
+                f"  {cores} cores: about {robots} robots, with {needed}"
+                + (f" and {drivers} fleet_driver process{'es' if drivers != 1 else ''}" if drivers else "")
+                + f" (bound: {bound})"
+            )
+    return lines
+
+
 def why_not_held(n: int, lidar: bool, r) -> str:
-    """What a fleet that fell behind real time needed: the simulator process alone (pybullet's
-    stepSimulation holds the interpreter lock, so the process steps on one core at a time), and the
-    whole stack against the machine's cores."""
-    simulator = n * (r["solver"] + r["simulator"])
-    stack = n * sum(r[role] for role in ROLES)
+    """What a fleet that fell behind real time needed: the simulator node's process (pybullet's
+    stepSimulation holds the interpreter lock, so the process steps on one core at a time; with
+    workers, the physics is theirs), and the whole stack against the machine's cores."""
+    stack = n * sum(r.get(role, 0.0) for role in ROLES)
     cores = os.cpu_count() or 1
+    if r.get("workers", 0.0) > 0.0:
+        node = (
+            f"the simulator node needs {n * r['simulator']:.2f} s of one core, its workers "
+            f"{n * (r['solver'] + r['workers']):.2f} s (solver {n * r['solver']:.2f} s)"
+        )
+    else:
+        node = (
+            f"the simulator process needs {n * (r['solver'] + r['simulator']):.2f} s of one core "
+            f"(solver {n * r['solver']:.2f} s)"
+        )
     return (
-        f"{n} robots{' with lidars' if lidar else ''} at {r['rtf']:.2f}: per simulated second the simulator process "
-        f"needs {simulator:.2f} s of one core (solver {n * r['solver']:.2f} s), the whole stack {stack:.2f} s "
-        f"of {cores} cores"
+        f"{n} robots{' with lidars' if lidar else ''} at {r['rtf']:.2f}: per simulated second {node}, "
+        f"the whole stack {stack:.2f} s of {cores} cores"
     )
+
+
+def describe(label: str) -> str:
+    """A stack's label (STACK[+PRESET][+wN]) in words, for the plot."""
+    stack, *rest = label.split("+")
+    words = [f"{stack} stack"]
+    for part in rest:
+        words.append(f"{part[1:]} physics workers" if part[:1] == "w" and part[1:].isdigit() else f"{part} physics")
+    return ", ".join(words)
 
 
 if __name__ == "__main__":

@@ -110,12 +110,12 @@ def test_main_job_records_a_real_bag_of_the_whole_drive_and_writes_figures_8_and
 def test_the_same_seed_in_lockstep_gives_the_same_report_with_both_cores_busy(demo, tmp_path):
     """Repeatable runs: the main job's field:3 drive along the field route, uncalibrated (on whatever
     machine load the suite had), and the same drive again here, beside two processes keeping both
-    cores busy, read the same figures and record the same drive states, ground truth and odometry, to
-    the bit, every message of them. In
-    lockstep the simulator starts paused, verification_drive unpauses it once every node is
+    cores busy and with the physics in two worker processes (the robot on one of them), read the same
+    figures and record the same drive states, ground truth and odometry, to the bit, every message of
+    them. In lockstep the simulator starts paused, verification_drive unpauses it once every node is
     connected, base_driver follows its stamped commands instant by instant, every sensor's noise is
     drawn for its instant, and what the run records is published waiting for its reader and recorded
-    by record_drive, which drops nothing."""
+    by record_drive, which drops nothing; a worker steps a robot as the node's own client does."""
     first = os.path.join(WS, "build", "field_route")
     burners = [subprocess.Popen(["python3", "-c", "while True: pass"]) for _ in range(2)]
     try:
@@ -134,6 +134,8 @@ def test_the_same_seed_in_lockstep_gives_the_same_report_with_both_cores_busy(de
                 str(tmp_path),
                 "--json",
                 str(tmp_path / "figures.json"),
+                "--physics-workers",
+                "2",
             ],
             timeout=600,
         )

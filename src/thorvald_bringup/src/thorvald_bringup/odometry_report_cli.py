@@ -32,6 +32,7 @@ from thorvald_base.verification import MANOEUVRES, SIDE
 from thorvald_model import ConfigError, load_robot_config
 from thorvald_model.ports import free_port
 from thorvald_sim.as_built import PROFILES, as_built_for, describe_as_built
+from thorvald_sim.params import MAX_WORKERS
 
 from .errors import DriveError, ReportError, ThorvaldBringupError, UnknownRobot
 
@@ -85,6 +86,14 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="FILE", help="also write the figures as JSON to FILE")
     p.add_argument("--real-time-factor", type=float, default=0.0, help="0: as fast as the machine can (default)")
     p.add_argument("--gui", action="store_true", help="open pybullet's window")
+    p.add_argument(
+        "--physics-workers",
+        type=int,
+        default=1,
+        metavar="N",
+        help="step the physics in N worker processes (the simulator's ~physics_workers; default 1: in the "
+        "simulator node). In lockstep the figures are the same to the bit",
+    )
     p.add_argument("--timeout", type=float, default=600.0, help="wall seconds the drive may take (default 600)")
     return p
 
@@ -115,7 +124,8 @@ def drive(
     log = os.path.join(os.path.dirname(bag), f"{log}_launch.log")
     wall, text = run_launch(
         args, "odometry_report.launch", [f"robot_model:={model}", f"bag:={bag}", f"manoeuvre:={manoeuvre}",
-        f"side:={side:g}"], log, f"{os.path.basename(model)[:-5]} through the {manoeuvre} manoeuvre",
+        f"side:={side:g}", f"physics_workers:={getattr(args, 'physics_workers', 1)}"], log,
+        f"{os.path.basename(model)[:-5]} through the {manoeuvre} manoeuvre",
     )  # fmt: skip
     if "Verification drive of" not in text or not os.path.isfile(bag):
         tail = "\n".join(text.splitlines()[-25:])
@@ -230,6 +240,8 @@ def run(args) -> int:
     built = as_built_for(args.as_built, config)  # refused here, before anything starts
     if args.as_built and args.as_built.partition(":")[0] not in PROFILES:
         args.as_built = os.path.abspath(args.as_built)  # the spawn runs elsewhere (in ~/.ros)
+    if not 1 <= args.physics_workers <= MAX_WORKERS:
+        raise ThorvaldBringupError(f"--physics-workers: {args.physics_workers}: must be in 1..{MAX_WORKERS}")
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
     name = os.path.splitext(os.path.basename(model))[0]
@@ -268,7 +280,8 @@ def run(args) -> int:
         print(f"  as built ({args.as_built}): {describe_as_built(built)}")
     if wall is not None:
         simulated = recording.states[-1][0] - recording.states[0][0]
-        print(f"  drive: {simulated:.1f} s simulated in {wall:.1f} s wall, world {args.world}")
+        workers = f", physics in {args.physics_workers} worker processes" if args.physics_workers > 1 else ""
+        print(f"  drive: {simulated:.1f} s simulated in {wall:.1f} s wall, world {args.world}{workers}")
         print(f"  lockstep: {'broken, this run may not repeat: ' + breaks[0] if breaks else 'kept throughout'}")
     if args.json:
         with open(args.json, "w") as f:
