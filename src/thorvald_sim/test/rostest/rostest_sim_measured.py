@@ -8,12 +8,13 @@ can accelerate at mu g = 0.98 m/s^2 at most, so ground truth falls behind odomet
 At speed, base_driver's motor controllers report the simulated motors' currents (drive_currents).
 """
 
+import time
 import unittest
 
 import numpy as np
 import rospy
 import rostest
-from sim_testing import Commander, Latest, delta, planar, sim_sleep
+from sim_testing import STARTUP, Commander, Latest, delta, planar, sim_sleep
 
 from thorvald_msgs.msg import BaseState, ControllerArray, DriveCurrents
 
@@ -82,7 +83,12 @@ class SimMeasuredTest(unittest.TestCase):
             rospy.Subscriber(f"/tarmac/{topic}", msg_type, lambda m, t=topic: stamps[t].append(m.header.stamp.to_sec()))
             for topic, msg_type in (("drive_currents", DriveCurrents), ("drive_states", BaseState))
         ]
-        sim_sleep(0.5)  # connected
+        # connected before the window opens (a fast simulation outran a fixed wait: a CI run missed two)
+        deadline = time.time() + STARTUP
+        while not all(sub.get_num_connections() for sub in subs):
+            self.assertLess(time.time(), deadline, "no connection to drive_currents and drive_states")
+            time.sleep(0.05)
+        sim_sleep(0.2)
         start = rospy.get_time()
         sim_sleep(2.5)
         for sub in subs:
