@@ -525,6 +525,7 @@ class Engine:
             solver_iterations=s.solver_iterations,
         )  # fmt: skip
         self.active: Dict[Tuple[str, int], bool] = {}  # a sensor had readers at its last step
+        self.passive: Dict[str, List[int]] = {}  # each robot's joints RobotIO reports, listed once at its spawn
 
     def handle(self, request):
         kind = request[0]
@@ -537,6 +538,7 @@ class Engine:
                 self.sim.delete(request[1])
             except SpawnError as e:
                 return ("refused", str(e))
+            self.passive.pop(request[1], None)
             return ("deleted",)
         if kind == "reset":
             self.sim.reset()
@@ -550,6 +552,7 @@ class Engine:
             robot = self.sim.spawn(name, urdf, pose, as_built)
         except SpawnError as e:
             return ("refused", str(e))
+        self.passive[name] = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
         info = {
             "description": robot.description,
             "wheels": robot.wheels,
@@ -583,7 +586,7 @@ class Engine:
             odometry = (robot.odom_pose(), robot.body_twist()) if r.odometry else None
             joints = None
             if r.joints:  # RobotIO's passive joints (pybullet reads no joints as None)
-                passive = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
+                passive = self.passive[name]
                 joints = robot.joint_states(passive) if passive else []
             sensors = self.read_sensors(robot, now, r.sensors)
             if r != NOTHING or sensors:
