@@ -179,13 +179,15 @@ def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determi
     determines 7 of its 12 combinations, and its own odometry after the calibration is closer to ground
     truth. Then its wheels balanced from their motor currents: they stop fighting, and each tyre's
     radius against the others' comes within the issue's 0.3 % of the as-built robot's, where ground
-    truth left it 0.9 % off. Last, straight legs at working speed with that in effect give the radii's
-    common factor, and the calibration reads their distance right."""
+    truth left it 0.9 % off. Then straight legs at working speed with that in effect give the radii's
+    common factor, and the calibration reads their distance right. Last, U turns of the working radius
+    give odometry's yaw-rate multiplier: its tyres slip in a turn, and the turns read short without it."""
     out = os.path.join(WS, "build", "calibration_drive")
     with open(os.path.join(out, "result.json")) as f:
         text = f.read()
     result = json.loads(text[text.index("{") :])
-    assert "calibration manoeuvre" in text and "balance manoeuvre" in text and "straight manoeuvre" in text
+    for manoeuvre in ("calibration", "balance", "straight", "turns"):
+        assert f"through the {manoeuvre} manoeuvre" in text, manoeuvre
     assert sum(c["determined"] for c in result["combinations"]) == 7 and len(result["combinations"]) == 12
     before, after = result["before"], result["after"]
     assert before["end_point_m"] > 1.0 and abs(before["distance_error_percent"]) > 1.0  # tyres 2 % small
@@ -204,9 +206,17 @@ def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determi
     assert [leg["straight"] for leg in straight["scale"]["legs"]] == [True] * 5
     assert 0.995 < straight["scale"]["factor"] < 1.01 and straight["scale"]["sd"] < 0.001
     assert abs(straight["after"]["distance_error_percent"]) < 0.05 < abs(straight["before"]["distance_error_percent"])
-    assert os.path.samefile(straight["calibration_file"], os.path.join(out, "calibration.yaml"))
+    assert os.path.samefile(straight["calibration_file"], os.path.join(out, "scaled_calibration.yaml"))
+    turns = result["turns"]
+    assert len(turns["turns"]) == 8 and turns["yaw_rate_multiplier"]["in_effect"] == 1.0
+    short = [1 - t["odometry_rad"] / t["truth_rad"] for t in turns["turns"]]
+    assert all(0.0 < s < 0.02 for s in short)  # every turn read short, by a few per mille
+    multiplier = turns["yaw_rate_multiplier"]["value"]
+    assert 1.0 < multiplier < 1.02 and turns["yaw_rate_multiplier"]["sd"] < 0.002
+    assert turns["after"]["end_point_m"] < turns["before"]["end_point_m"]
+    assert os.path.samefile(turns["calibration_file"], os.path.join(out, "calibration.yaml"))
     names = ("calibration.yaml", "odometry_calibration.yaml", "balanced.yaml", "balanced_calibration.yaml")
-    for name in (*names, "calibration_drive.bag", "straight.bag"):
+    for name in (*names, "scaled_calibration.yaml", "calibration_drive.bag", "straight.bag", "turns.bag"):
         assert os.path.isfile(os.path.join(out, name)), name
     assert "field:3 on the field route against RTK-GNSS: uncalibrated" in demo
 

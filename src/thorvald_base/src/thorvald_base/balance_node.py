@@ -38,7 +38,7 @@ from thorvald_model.motors import Motor, output_torque, propulsion_motor
 from thorvald_msgs.msg import ControllerArray, DriveParam
 from thorvald_msgs.srv import DriveParams
 
-from .calibration.calibration_file import changes_yaml, load_calibration
+from .calibration.calibration_file import CalibrationValues, changes_yaml, read_calibration
 from .calibration.torque_balance import Leg, fight_power, fit_balance, next_radii
 from .errors import CalibrationError
 from .verification import BALANCE_SPEED, balance_legs
@@ -53,7 +53,8 @@ class BalanceDrive(VerificationDrive):
         super().__init__("balance")
         self.motors: List[Motor] = [propulsion_motor(d) for d in self.config.drives]
         path = str(rospy.get_param("~calibration", "") or "")
-        self.calibration = load_calibration(path, self.config) if path else []
+        self.in_effect = read_calibration(path, self.config) if path else CalibrationValues()
+        self.calibration = list(self.in_effect.changes)
         config = self.config
         for index, key, value in self.calibration:
             config = config.with_drive_param(index, key, value)
@@ -134,7 +135,7 @@ class BalanceDrive(VerificationDrive):
                 "the other values as the calibration it started with"
             )
             with open(self.out, "w") as f:
-                f.write(changes_yaml(changes, header, extra=self.calibration))
+                f.write(changes_yaml(changes, header, self.calibration, self.in_effect.yaw_rate_multiplier))
             text += f"\nwrote {os.path.abspath(self.out)}"
         if self.json:
             with open(self.json, "w") as f:

@@ -84,7 +84,7 @@ from .bases.handle import DriveTopics, Ports
 from .core import BaseDriverCore, PoseCovariance
 from .diagnostics import LinkWatch, base_statuses
 from .errors import ParameterError, ThorvaldBaseError
-from .lockstep import LockstepCycles, apply_calibration
+from .lockstep import LockstepCycles, apply_calibration, calibration_said
 from .node_names import Names, Throttle
 from .params import PARAMETER_NAMES, DriverParams
 from .plugins import load_calculator
@@ -273,12 +273,7 @@ class BaseDriverNode:
     def apply_calibration(self, path):
         """The calibration file's values, checked against the robot and applied as set_drive_params
         applies them (the handle built on the robot file keeps its spawn radii: simulated_joints)."""
-        changes = apply_calibration(self.core, path)
-        rospy.loginfo(
-            self.label + ": calibration %s: %s",
-            path,
-            ", ".join(f"drive{i} {key} {value:g}" for i, key, value in changes) or "nothing to change",
-        )
+        rospy.loginfo(self.label + ": calibration %s: %s", path, calibration_said(apply_calibration(self.core, path)))
 
     # ---- callbacks: message -> core -> message -----------------------------------------------
     def on_cmd_vel(self, msg):

@@ -44,13 +44,14 @@ from .calibration import (
     calibrate,
     calibration_yaml,
     common_scale,
-    load_calibration,
     local_metres,
     observable_fit,
     odometry_error,
     set_drive_params_command,
 )
+from .calibration.calibration_file import changes_yaml, read_calibration
 from .calibration.observable import FAR, along_undetermined
+from .calibration.turns import TurnFit, turn_fit
 from .conversions import quaternion_yaw
 from .errors import CalibrationError, ThorvaldBaseError
 
@@ -167,12 +168,14 @@ def parse_args(argv: Optional[List[str]]):
     )
     parser.add_argument(
         "--fit",
-        choices=("drives", "odometry", "scale"),
+        choices=("drives", "odometry", "scale", "turns"),
         default="drives",
         help="drives: each drive's radius and offset from its own wheel's motion (the default); odometry: only "
         "the combinations the drive determines through the odometry, the rest kept at the values in effect "
         "(the simulator's ground truth); scale: only the radii's common factor, from straight legs between "
-        "standstills (the straight manoeuvre, driven with the calibration in effect)",
+        "standstills (the straight manoeuvre, driven with the calibration in effect); turns: only odometry's "
+        "yaw-rate multiplier, from U turns of the working radius (the turns manoeuvre, driven with the "
+        "calibration in effect)",
     )
     parser.add_argument(
         "--balance",
@@ -199,14 +202,20 @@ def run(args) -> int:
     if not args.window > 0:
         raise CalibrationError(f"--window: {args.window!r}: must be > 0 [s]")
     robot = load_robot_config(args.robot_model)
-    in_effect, earlier = robot, []
+    in_effect, earlier, multiplier = robot, [], None
     if args.calibration:
-        earlier = load_calibration(args.calibration, robot)
+        values = read_calibration(args.calibration, robot)
+        earlier, multiplier = list(values.changes), values.yaw_rate_multiplier
         for index, key, value in earlier:
             in_effect = in_effect.with_drive_param(index, key, value)
-    if args.fit == "scale" and args.balance:
-        raise CalibrationError("--balance goes with --fit drives or odometry: --fit scale keeps every radius's share")
+    if args.fit in ("scale", "turns") and args.balance:
+        raise CalibrationError(
+            f"--balance goes with --fit drives or odometry: --fit {args.fit} keeps every radius's share"
+        )
     recording, truth, said, namespace = read_bag(args.bag, len(robot.drives), args.ground_truth, args.antenna)
+    if args.fit == "turns":
+        return run_turns(args, in_effect, recording, truth, said=said, earlier=earlier, multiplier=multiplier)
+    yaw_rate = 1.0 if multiplier is None else multiplier
     scale = None
     if args.fit == "scale":
         scale = common_scale(in_effect, recording, truth)
@@ -222,13 +231,15 @@ def run(args) -> int:
         calibration = calibrate(in_effect, recording, truth, window=args.window)
         observable = observable_fit(in_effect, recording, truth) if isinstance(truth, PoseTruth) else None
     if args.balance:
-        calibration = with_balance(calibration, observable, load_calibration(args.balance, robot), robot)
+        calibration = with_balance(calibration, observable, list(read_calibration(args.balance, robot).changes), robot)
     calibrated = calibration.calibrated(in_effect)
     bias = calibration.heading_bias[0] if calibration.heading_bias else 0.0
-    before = odometry_error(in_effect, recording, truth, bias)
-    after = odometry_error(calibrated, as_read_with(recording, in_effect, calibrated), truth, bias)
-    out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.bag)), "calibration.yaml")
-    kept = write_file(out, calibration, earlier, args, said)
+    before = odometry_error(in_effect, recording, truth, bias, yaw_rate_multiplier=yaw_rate)
+    after = odometry_error(
+        calibrated, as_read_with(recording, in_effect, calibrated), truth, bias, yaw_rate_multiplier=yaw_rate
+    )
+    out = args.out or default_out(args)
+    kept = write_file(out, calibration, earlier, args, said, multiplier=multiplier)
     outcome = Outcome(
         calibration,
         said,
@@ -285,22 +296,92 @@ class Outcome:
     scale: Optional[ScaleFit] = None  # --fit scale's legs
 
 
-def write_file(path: str, calibration: Calibration, earlier, args, said: str) -> bool:
-    """The estimates, over the calibration in effect (what was not estimated again is kept from it)."""
-    estimated = {(p.index, p.key) for p in calibration.estimated}
-    kept = [(i, key, value) for i, key, value in earlier if (i, key) not in estimated]
-    header = (
+def default_out(args) -> str:
+    return os.path.join(os.path.dirname(os.path.abspath(args.bag)), "calibration.yaml")
+
+
+def run_turns(args, in_effect, recording, truth, *, said: str, earlier, multiplier: Optional[float]) -> int:
+    """--fit turns: the yaw-rate multiplier from the drive's turns, every drive value kept."""
+    in_use = 1.0 if multiplier is None else multiplier
+    fit = turn_fit(in_effect, recording, truth, in_use)
+    # as --fit scale: GNSS's end point taken with the IMU's yaw as it reads (its bias is not estimated here)
+    before = odometry_error(in_effect, recording, truth, yaw_rate_multiplier=in_use)
+    after = odometry_error(in_effect, recording, truth, yaw_rate_multiplier=fit.multiplier)
+    out = args.out or default_out(args)
+    header = header_lines(args, out, said)
+    header += f"\nthe yaw-rate multiplier from {len(fit.turns)} turns"
+    if earlier:
+        header += f"; the drives' values kept from {args.calibration}"
+    write_text(out, changes_yaml([], header, extra=earlier, yaw_rate_multiplier=fit.multiplier))
+    if args.json:
+        print(json.dumps(turns_json(fit, said, before, after, out), indent=2))
+    else:
+        print_turns(fit, said, (before, after), path=out, kept=bool(earlier))
+    return 0
+
+
+def header_lines(args, path: str, said: str) -> str:
+    return (
         f"odometry calibration of {args.robot_model}\nfrom {os.path.abspath(args.bag)}, ground truth {said}\n"
         f"base_driver: ~calibration (base_bringup.launch calibration:={path})"
     )
-    if kept:
-        header += f"\nkept from {args.calibration}: " + ", ".join(f"drive{i} {key}" for i, key, _ in kept)
-    text = calibration_yaml(calibration, header, extra=kept)
+
+
+def write_text(path: str, text: str) -> None:
     try:
         with open(path, "w") as f:
             f.write(text)
     except OSError as e:
         raise CalibrationError(f"{path}: cannot write the calibration file: {e.strerror}") from None
+
+
+def turns_json(fit: TurnFit, said: str, before: OdometryError, after: OdometryError, path: str) -> dict:
+    return {
+        "fit": "turns",
+        "ground_truth_source": said,
+        "turns": [
+            {"start": turn.start, "end": turn.end, "truth_rad": turn.truth, "odometry_rad": turn.odometry}
+            for turn in fit.turns
+        ],
+        "yaw_rate_multiplier": {"value": fit.multiplier, "sd": _number(fit.multiplier_sd), "in_effect": fit.in_effect},
+        "before": _errors(before),
+        "after": _errors(after),
+        "calibration_file": path,
+    }
+
+
+def print_turns(fit: TurnFit, said: str, errors: Tuple[OdometryError, OdometryError], *, path: str, kept: bool) -> None:
+    before, after = errors
+    print(f"ground truth: {said}; {len(fit.turns)} turns")
+    for turn in fit.turns:
+        print(
+            f"  turn {turn.start:7.2f} to {turn.end:7.2f} s: ground truth {math.degrees(turn.truth):+8.2f} deg, "
+            f"odometry {math.degrees(turn.odometry):+8.2f} deg ({turn.short_percent:+.2f} % short)"
+        )
+    print(
+        f"odometry's yaw-rate multiplier: {fit.multiplier:.5f} ± {fit.multiplier_sd:.5f} "
+        f"(was {fit.in_effect:g}; the turns read {100 * (fit.gain - 1):+.3f} % short with it)"
+    )
+    print(
+        f"odometry against ground truth: before {before.distance_error_percent:+.3f} % of "
+        f"{before.truth_distance_m:.2f} m, end point {before.end_point_m:.3f} m; after "
+        f"{after.distance_error_percent:+.3f} %, end point {after.end_point_m:.3f} m"
+    )
+    print(f"wrote {path}" + (" (with the drives' values of the calibration in effect)" if kept else ""))
+    print("base_driver applies it at start (~calibration); set_drive_params does not change the multiplier")
+
+
+def write_file(path: str, calibration: Calibration, earlier, args, said: str, *, multiplier=None) -> bool:
+    """The estimates, over the calibration in effect (what was not estimated again is kept from it, the
+    yaw-rate multiplier too)."""
+    estimated = {(p.index, p.key) for p in calibration.estimated}
+    kept = [(i, key, value) for i, key, value in earlier if (i, key) not in estimated]
+    header = header_lines(args, path, said)
+    if kept or multiplier is not None:
+        names = [f"drive{i} {key}" for i, key, _ in kept] + (["yaw_rate_multiplier"] if multiplier is not None else [])
+        header += f"\nkept from {args.calibration}: " + ", ".join(names)
+    text = calibration_yaml(calibration, header, extra=kept, yaw_rate_multiplier=multiplier)
+    write_text(path, text)
     return bool(kept)
 
 

@@ -10,14 +10,14 @@ first instant is a cycle too, as there are no commands yet to answer it with.
 thorvald_sim's runner in the same process as the simulation.
 
 :func:`apply_calibration` is base_driver's ``~calibration``: the file's values checked against the
-robot and applied as ``set_drive_params`` applies them.
+robot and applied as ``set_drive_params`` applies them, its yaw-rate multiplier to the calculator.
 
 Pure: no rospy.
 """
 
-from typing import List, Optional, Tuple
+from typing import Optional, Tuple
 
-from .calibration import load_calibration
+from .calibration.calibration_file import CalibrationValues, read_calibration
 from .core import BaseDriverCore, CycleResult
 from .errors import ParameterError
 from .rate_grid import RateGrid
@@ -59,12 +59,22 @@ class LockstepCycles:
         self.core.handle.answer(t)
 
 
-def apply_calibration(core: BaseDriverCore, path: str) -> List[Tuple[int, str, float]]:
+def apply_calibration(core: BaseDriverCore, path: str) -> CalibrationValues:
     """A calibration file's values (calibrate_odometry writes it), checked against the core's robot
-    and applied through set_drive_params; the changes made. ConfigError for a broken file,
-    ParameterError for values the robot refuses."""
-    changes = load_calibration(path, core.config)
-    _, problems = core.set_drive_params(changes)
+    and applied: the drives' through set_drive_params, the yaw-rate multiplier to the calculator's
+    odometry; what it set. ConfigError for a broken file, ParameterError for values the robot refuses."""
+    values = read_calibration(path, core.config)
+    _, problems = core.set_drive_params(list(values.changes))
     if problems:
         raise ParameterError(f"~calibration: {path}: " + "; ".join(problems))
-    return changes
+    if values.yaw_rate_multiplier is not None:
+        core.calculator.yaw_rate_multiplier = values.yaw_rate_multiplier
+    return values
+
+
+def calibration_said(values: CalibrationValues) -> str:
+    """What a calibration file set, in a few words (base_driver logs it)."""
+    said = [f"drive{i} {key} {value:g}" for i, key, value in values.changes]
+    if values.yaw_rate_multiplier is not None:
+        said.append(f"odometry yaw_rate_multiplier {values.yaw_rate_multiplier:g}")
+    return ", ".join(said) or "nothing to change"

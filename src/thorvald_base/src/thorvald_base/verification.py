@@ -37,8 +37,9 @@ def plan_for(config: RobotConfig) -> Tuple[str, List[Segment]]:
     return "a stadium twice: straights and half circles about its axle line", _stadium(axle)
 
 
-MANOEUVRES = ("verification", "calibration", "field", "balance", "straight")
+MANOEUVRES = ("verification", "calibration", "field", "balance", "straight", "turns")
 ROWS, ROW_LENGTH, ROW_SPACING = 5, 15.0, 1.5  # the field route: every second row of 0.75 m rows
+TURN_SIGNS = (1.0, 1.0, -1.0, -1.0, 1.0, 1.0, -1.0, -1.0)  # the turns manoeuvre's U turns: two loops each way
 SIDE = 4.0  # [m] of the calibration drive's square (UMBmark's 4 m)
 CORNER = 1.0  # [m] a fixed-axle robot's corner radius on the calibration drive (about a point of its axle line)
 TURN_SHARE = 0.9  # of a wheel's speed limit: a fixed-axle robot's turns are slowed to keep within it
@@ -64,7 +65,7 @@ def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str,
             f"a field route: {ROWS} rows of {ROW_LENGTH:g} m, {ROW_SPACING:g} m apart, joined by headland U turns",
             _field_route(config),
         )
-    if name not in ("calibration", "balance", "straight"):
+    if name not in ("calibration", "balance", "straight", "turns"):
         raise ValueError(f"manoeuvre must be one of {', '.join(MANOEUVRES)}, not {name!r}")
     if not (side > 0.0 and math.isfinite(side)):
         raise ValueError(f"side must be a positive length [m], not {side!r}")
@@ -73,6 +74,12 @@ def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str,
             f"balancing the wheels: {BALANCE_LEGS} straight legs of {side:g} m back and forth at "
             f"{BALANCE_SPEED:g} m/s, the radii changed between them",
             _balance(config, side),
+        )
+    if name == "turns":
+        return (
+            f"turns: {len(TURN_SIGNS)} headland U turns of the field route's radius ({ROW_SPACING / 2:g} m), "
+            f"twice left and twice right in turn, joined by {side:g} m rows",
+            _turns(config, side),
         )
     if name == "straight":
         return (
@@ -217,12 +224,26 @@ def balance_legs(plan: Sequence[Segment]) -> List[Tuple[float, float, float]]:
     return out
 
 
+def _turns(config: RobotConfig, side: float) -> List[Segment]:
+    """The field route's headland U turns (the working radius, where a calibrated yaw-rate multiplier
+    must hold), TURN_SIGNS in order, each between rows of side [m]: two left turns drive a loop back
+    to the start, then two right ones the mirrored loop, so the drive stays within side by two row
+    spacings; a last row ends it, side ahead of the start."""
+    return _rows_and_turns(config, side, TURN_SIGNS)
+
+
 def _field_route(config: RobotConfig) -> List[Segment]:
     """A drive unlike the calibration drive, about the paper's length: rows along the robot's rolling
     direction joined by half circles at the headland, alternately left and right, as a robot working
     every second row of a field drives them (a robot whose every wheel steers turns about a point
     half the spacing to the side; a fixed-axle robot about such a point of its axle line, slowed as
     its calibration drive's turns are)."""
+    return _rows_and_turns(config, ROW_LENGTH, [1.0 if row % 2 == 0 else -1.0 for row in range(ROWS - 1)])
+
+
+def _rows_and_turns(config: RobotConfig, length: float, signs: Sequence[float]) -> List[Segment]:
+    """Rows of length [m] along the rolling direction, joined by headland U turns (sign 1: left) about
+    a point ROW_SPACING / 2 to that side (of the axle line, for a fixed-axle robot), then a stop."""
     axle, _ = common_axle(config.drives, config.passive_wheels)
     if axle is None:
         dx, dy, ax, ay = 0.0, 1.0, 0.0, 0.0  # turn about (0, +-spacing/2), straight along +x
@@ -232,10 +253,10 @@ def _field_route(config: RobotConfig) -> List[Segment]:
     foot = -(ax * dx + ay * dy)
     straight = Twist(SPEED * nx, SPEED * ny, 0.0)
     legs = []
-    for row in range(ROWS):
-        legs.append(Segment(straight, ROW_LENGTH / SPEED, f"row {row + 1}, {ROW_LENGTH:g} m"))
-        if row < ROWS - 1:
-            sign = 1.0 if row % 2 == 0 else -1.0
+    for row in range(len(signs) + 1):
+        legs.append(Segment(straight, length / SPEED, f"row {row + 1}, {length:g} m"))
+        if row < len(signs):
+            sign = signs[row]
             offset = foot + sign * ROW_SPACING / 2.0
             turn = _turn(ax + offset * dx, ay + offset * dy, sign, config.drives)
             legs.append(Segment(turn, math.pi / abs(turn.wz), f"headland U turn {'left' if sign > 0 else 'right'}"))

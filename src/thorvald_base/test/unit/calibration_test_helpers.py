@@ -121,3 +121,22 @@ DIFF_DRIVE = (
 STRAIGHT = ((30.0, Twist(1.0, 0.0, 0.0)),)
 
 DEG = math.pi / 180.0
+
+
+def with_turn_slip(drive: Synthetic, left: float, right: float, start: Optional[Pose] = None) -> Synthetic:
+    """The drive's ground truth as if the body turned left turns ``left`` times and right turns ``right``
+    times as fast as the wheels say (tyres that slip in a turn), the translation in base_link kept; the
+    drive states are the same. The IMU reads that heading (no bias)."""
+    start = start or Pose(drive.pose_truth.x[0], drive.pose_truth.y[0], float(drive.pose_truth.yaw[0]))
+    poses = [start]
+    for twist in drive.twists[1:]:
+        gain = left if twist.wz > 0 else right
+        poses.append(integrate_se2(poses[-1], Twist(twist.vx, twist.vy, twist.wz * gain), 1.0 / RATE))
+    t = drive.pose_truth.t
+    x = np.array([p.x for p in poses])
+    y = np.array([p.y for p in poses])
+    yaw = np.unwrap([p.yaw for p in poses])
+    wz = np.array([tw.wz * (left if tw.wz > 0 else right) for tw in drive.twists])
+    truth = PoseTruth(t, x, y, yaw, drive.pose_truth.vx, drive.pose_truth.vy, wz)
+    gnss = GnssTruth(t[::5], x[::5], y[::5], t, yaw)
+    return Synthetic(drive.recording, truth, gnss, drive.twists)

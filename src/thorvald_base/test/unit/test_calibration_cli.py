@@ -216,6 +216,47 @@ def test_fit_scale_takes_the_radii_common_factor_from_straight_legs_over_the_cal
         assert status == 2 and err.count("\n") == 1 and message in err, err
 
 
+def test_fit_turns_takes_the_yaw_rate_multiplier_from_the_turns_over_the_calibration_in_effect(tmp_path, capsys, std):
+    from calibration_test_helpers import with_turn_slip  # noqa: PLC0415
+
+    from thorvald_base.calibration.calibration_file import read_calibration  # noqa: PLC0415
+    from thorvald_base.verification import plan_named  # noqa: PLC0415
+
+    earlier = tmp_path / "earlier.yaml"
+    earlier.write_text("motor_drives:\n  drive1: {r_wheel: 0.205}\nodometry: {yaw_rate_multiplier: 1.002}\n")
+    in_effect = std.with_drive_param(1, "r_wheel", 0.205)
+    plan = [(s.duration, s.twist) for s in plan_named("turns", std, side=3.0)[1]]
+    radii = [d.r_wheel for d in in_effect.drives]
+    drive = with_turn_slip(synthetic_drive(in_effect, plan, radii, [0.0] * 4), left=1.005, right=1.005)
+    bag = write_bag(tmp_path / "turns.bag", drive, gnss=True)
+    status, out, err = run(capsys, bag, "--robot-model", STD, "--calibration", earlier, "--fit", "turns")
+    assert status == 0, err
+    assert "ground truth: the simulator's /robot_1/odometry/gazebo; 8 turns" in out
+    assert out.count(" % short)") == 8 and "(+0.30 % short)" in out  # 1.005 slip against 1.002 in effect
+    assert "odometry's yaw-rate multiplier: 1.00500 ± 0.00000 (was 1.002;" in out
+    assert re.search(
+        r"before [+-]0\.000 % of [0-9.]+ m, end point 0\.[0-9]{3} m; after [+-]0\.000 %, end point 0\.000", out
+    )
+    values = read_calibration(str(tmp_path / "calibration.yaml"), std)
+    assert values.changes == ((1, "r_wheel", 0.205),)  # the drives' values kept
+    assert values.yaw_rate_multiplier == pytest.approx(1.005, abs=1e-6)
+    # from the IMU's yaw, as JSON
+    status, out, err = run(capsys, bag, "--robot-model", STD, "--fit", "turns", "--ground-truth", "gnss", "--json")
+    assert status == 0, err
+    result = json.loads(out)
+    assert result["fit"] == "turns" and len(result["turns"]) == 8
+    assert result["yaw_rate_multiplier"]["value"] == pytest.approx(1.005, abs=1e-6)
+    assert result["yaw_rate_multiplier"]["in_effect"] == 1.0
+    # a drive without turns, and --balance, are refused in one line
+    straight = write_bag(tmp_path / "straight.bag", synthetic_drive(std, STRAIGHT, RADII, OFFSETS))
+    for bag_, extra, message in (
+        (straight, [], "drive the turns manoeuvre"),
+        (bag, ["--balance", earlier], "goes with"),
+    ):
+        status, out, err = run(capsys, bag_, "--robot-model", STD, "--fit", "turns", *extra)
+        assert status == 2 and err.count("\n") == 1 and message in err, err
+
+
 BAD_BAGS = [
     (lambda p, d: p.write_text("not a bag") or str(p), [], "cannot read the bag"),
     (lambda p, d: str(p) + ".missing", [], "cannot read the bag"),

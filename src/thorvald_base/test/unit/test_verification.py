@@ -126,10 +126,14 @@ def _truthful(drive):
 
 def test_a_manoeuvre_of_another_name_or_a_bad_side_is_refused():
     config = four_ws()
-    with pytest.raises(ValueError, match="one of verification, calibration, field, balance, straight, not 'umbmark'"):
+    with pytest.raises(
+        ValueError, match="one of verification, calibration, field, balance, straight, turns, not 'umbmark'"
+    ):
         plan_named("umbmark", config)
     with pytest.raises(ValueError, match="side must be a positive length"):
         plan_named("calibration", config, side=0.0)
+    with pytest.raises(ValueError, match="side must be a positive length"):
+        plan_named("turns", config, side=float("nan"))
     assert plan_named("verification", config) == plan_for(config)
 
 

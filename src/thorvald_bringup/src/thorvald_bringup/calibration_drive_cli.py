@@ -18,7 +18,12 @@ A robot of more than two drives (whose wheels can fight on one rigid frame) goes
 sets each tyre's radius against the others' from the motors' currents (balanced.yaml); the
 calibration drive's fit is taken again with it (``calibrate_odometry --balance``,
 balanced_calibration.yaml); and the straight manoeuvre, driven at working speed with that in effect,
-gives the radii's common factor (``calibrate_odometry --fit scale``): calibration.yaml.
+gives the radii's common factor (``calibrate_odometry --fit scale``): scaled_calibration.yaml.
+
+Last, unless ``--no-turns``, the turns manoeuvre (the field route's headland U turns, twice each way,
+twice) is driven with all that in effect, and odometry's yaw-rate multiplier fitted to its turns
+(``calibrate_odometry --fit turns``): calibration.yaml, what base_driver loads. The tyres slip in a
+turn, and no radius or offset makes the wheels' geometry read a turn as the body turns.
 
 Exit status 0 with the calibration; 2 with the reason on stderr (a robot file's problems, one per
 line; otherwise one line) and no traceback.
@@ -31,6 +36,7 @@ import json
 import os
 import sys
 import textwrap
+from typing import Optional
 
 from thorvald_base.calibration.calibration_file import load_calibration
 from thorvald_base.calibration.torque_balance import relative_errors
@@ -48,6 +54,8 @@ BALANCED = "balanced.yaml"  # balance_wheels': the radii where the wheels do not
 BALANCE_JSON = "balance.json"
 BALANCED_FIT = "balanced_calibration.yaml"  # the calibration drive's fit with the balance, before the straight legs
 STRAIGHT_BAG = "straight.bag"
+SCALED = "scaled_calibration.yaml"  # the straight legs' common factor on the balanced fit, before the turns
+TURNS_BAG = "turns.bag"
 
 
 def parser() -> argparse.ArgumentParser:
@@ -75,6 +83,10 @@ def parser() -> argparse.ArgumentParser:
         help="then balance the wheels from their motor currents (default: a robot of more than two drives)",
     )  # fmt: skip
     balance.add_argument("--no-balance", dest="balance", action="store_false", help="calibrate from ground truth alone")
+    p.add_argument(
+        "--no-turns", dest="turns", action="store_false",
+        help="leave out the last drive, the U turns that fit odometry's yaw-rate multiplier",
+    )  # fmt: skip
     p.add_argument("--out", metavar="DIR", default="calibration_drive", help="the bag's and the calibration's folder")
     p.add_argument("--json", action="store_true", help="print calibrate_odometry's results as JSON")
     p.add_argument("--real-time-factor", type=float, default=0.0, help="0: as fast as the machine can (default)")
@@ -114,7 +126,11 @@ def run(args) -> int:
     # ROS's Python (rosbag) only now: --help and bad robots stay fast
     from thorvald_base.calibration_cli import main as calibrate_odometry  # noqa: PLC0415
 
-    first = os.path.join(out, ODOMETRY if balance else CALIBRATION)
+    final = os.path.join(out, CALIBRATION)
+    for stale in (os.path.join(out, name) for name in (CALIBRATION, ODOMETRY, SCALED)):
+        if os.path.exists(stale):
+            os.remove(stale)
+    first = os.path.join(out, ODOMETRY if balance or args.turns else CALIBRATION)
     command = [bag, "--robot-model", model, "--out", first]
     command += ["--ground-truth", args.ground_truth, "--fit", args.fit]
     if args.calibration:
@@ -122,7 +138,25 @@ def run(args) -> int:
     if args.json:
         command.append("--json")
     if not balance:
-        return calibrate_odometry(command)
+        if not args.turns:
+            return calibrate_odometry(command)
+        captured = io.StringIO()
+        with contextlib.redirect_stdout(captured):
+            status = calibrate_odometry(command)
+        text = captured.getvalue()
+        if status != 0:
+            print(text, end="")
+            return status
+        if not args.json:
+            print(text, end="", flush=True)
+        turns = turns_step(args, model, first, out, calibrate_odometry)
+        if turns is None:
+            return 2
+        if args.json:
+            result = json.loads(text[text.index("{") :])
+            result["turns"] = turns
+            print(json.dumps(result, indent=2))
+        return 0
     captured = io.StringIO()
     with contextlib.redirect_stdout(captured):
         status = calibrate_odometry(command)
@@ -134,9 +168,9 @@ def run(args) -> int:
         print(text, end="", flush=True)
     balanced_file = os.path.join(out, BALANCED)
     figures = os.path.join(out, BALANCE_JSON)
-    final = os.path.join(out, CALIBRATION)
+    scaled = os.path.join(out, SCALED if args.turns else CALIBRATION)
     balanced_fit = os.path.join(out, BALANCED_FIT)
-    for stale in (balanced_file, figures, final, balanced_fit):
+    for stale in (balanced_file, figures, balanced_fit):
         if os.path.exists(stale):
             os.remove(stale)
     launch_args = [f"robot_model:={model}", f"side:={args.side:g}", f"out:={balanced_file}", f"json:={figures}"]
@@ -171,7 +205,7 @@ def run(args) -> int:
     straight_bag = os.path.join(out, STRAIGHT_BAG)
     with_fit = argparse.Namespace(**{**vars(args), "calibration": balanced_fit})
     wall, _ = drive(with_fit, model, straight_bag, "straight", args.side, log="straight")
-    scale = [straight_bag, "--robot-model", model, "--out", final, "--calibration", balanced_fit, "--fit", "scale"]
+    scale = [straight_bag, "--robot-model", model, "--out", scaled, "--calibration", balanced_fit, "--fit", "scale"]
     scale += ["--ground-truth", args.ground_truth, *(["--json"] if args.json else [])]
     if not args.json:
         print(f"  drive: {wall:.1f} s wall; bag {straight_bag}", flush=True)
@@ -183,6 +217,13 @@ def run(args) -> int:
         print(captured.getvalue(), end="")
         return status
     text = captured.getvalue()
+    if not args.json:
+        print(text, end="", flush=True)
+    turns = None
+    if args.turns:
+        turns = turns_step(args, model, scaled, out, calibrate_odometry)
+        if turns is None:
+            return 2
     tyres = None
     if args.as_built:
         tyres = tyre_errors(config, built, load_calibration(first, config), balanced, load_calibration(final, config))
@@ -190,11 +231,12 @@ def run(args) -> int:
         result = json.loads(fit_text[fit_text.index("{") :])
         result["balance"] = balanced
         result["straight"] = json.loads(text[text.index("{") :])
+        if turns is not None:
+            result["turns"] = turns
         if tyres is not None:
             result["tyres"] = tyres
         print(json.dumps(result, indent=2))
         return 0
-    print(text, end="")
     if tyres is not None:
         names = ("configured", "ground_truth", "balanced", "calibration")
         largest = [tyres[k]["largest_percent"] for k in names]
@@ -205,6 +247,29 @@ def run(args) -> int:
             "{:.2f}, {:.2f})".format(*largest, *relative)
         )
     return 0
+
+
+def turns_step(args, model: str, in_effect: str, out: str, calibrate_odometry) -> Optional[dict]:
+    """The turns manoeuvre driven with the calibration file in_effect, and odometry's yaw-rate multiplier
+    fitted to it over that file into calibration.yaml; --fit turns' JSON with --json (else its text is
+    printed and the dict is empty), or None when the fit failed (its reason printed)."""
+    bag = os.path.join(out, TURNS_BAG)
+    with_fit = argparse.Namespace(**{**vars(args), "calibration": in_effect})
+    wall, _ = drive(with_fit, model, bag, "turns", args.side, log="turns")
+    command = [bag, "--robot-model", model, "--out", os.path.join(out, CALIBRATION), "--calibration", in_effect]
+    command += ["--fit", "turns", "--ground-truth", args.ground_truth, *(["--json"] if args.json else [])]
+    if not args.json:
+        print(f"  drive: {wall:.1f} s wall; bag {bag}", flush=True)
+        print("\nodometry's yaw-rate multiplier from U turns of the working radius, all that in effect:", flush=True)
+    captured = io.StringIO()
+    with contextlib.redirect_stdout(captured):
+        status = calibrate_odometry(command)
+    text = captured.getvalue()
+    if status != 0 or not args.json:
+        print(text, end="", flush=True)
+    if status != 0:
+        return None
+    return json.loads(text[text.index("{") :]) if args.json else {}
 
 
 def fights(config) -> bool:

@@ -3,16 +3,20 @@
     motor_drives:
       drive0: {r_wheel: 0.20131, steering_offset: 0.0042}
       drive2: {r_wheel: 0.19874}
+    odometry:
+      yaw_rate_multiplier: 1.0061
 
 Any drive key set_drive_params may change (thorvald_model's RUNTIME_DRIVE_KEYS) may be given; base_driver
-applies the file through set_drive_params, so each value is checked as the robot file's is. Reading it
+applies the file through set_drive_params, so each value is checked as the robot file's is.
+``odometry.yaw_rate_multiplier`` (``calibrate_odometry --fit turns``) multiplies the yaw rate odometry
+reads (the calculator's ``yaw_rate_multiplier``): turns of the working radius read as truth turns them. Reading it
 (:func:`load_calibration`) checks it first against the robot it is for, with the robot file's loader
 helpers, and reports every problem with this file's name, the key path, the value and the rule.
 
 Pure: no rospy, no messages.
 """
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 import yaml
@@ -20,17 +24,38 @@ import yaml
 from thorvald_model.config import RUNTIME_DRIVE_KEYS
 from thorvald_model.errors import MISSING, ConfigError, Problem
 from thorvald_model.keys import DRIVE_KEYS
-from thorvald_model.schema import check_top_level, parse_entry, read_yaml_file
+from thorvald_model.schema import Key, check_top_level, parse_entry, read_yaml_file
 from thorvald_model.values import RobotConfig
 
+from ..kinematics.calculator import YAW_RATE_MULTIPLIER_RANGE
 from .estimate import Calibration
 
 WHAT = "calibration file"
-TOP_KEYS = ("motor_drives",)
+TOP_KEYS = ("motor_drives", "odometry")
 # the drive keys a calibration may set, each given or not (None: not given)
 KEYS = tuple(replace(k, default=None) for k in DRIVE_KEYS if k.runtime)
-
 Change = Tuple[int, str, float]  # (drive index, key, value), as set_drive_params takes it
+_LOW, _HIGH = YAW_RATE_MULTIPLIER_RANGE
+ODOMETRY_KEYS = (
+    Key(
+        "yaw_rate_multiplier",
+        float,
+        None,
+        lambda v: _LOW <= v <= _HIGH,
+        f"must be in [{_LOW:g}, {_HIGH:g}] (a turn read a few per mille short is tyre slip; 10 % is a wrong robot "
+        "file)",
+    ),
+)
+
+
+@dataclass(frozen=True)
+class CalibrationValues:
+    """What a calibration file sets: drive changes, and the yaw-rate multiplier (None: not given)."""
+
+    changes: Tuple[Change, ...] = ()
+    yaw_rate_multiplier: Optional[float] = None
+
+
 _KEY_ORDER = {k.name: n for n, k in enumerate(DRIVE_KEYS)}  # the robot file's order of a drive's keys
 
 
@@ -40,9 +65,11 @@ def calibration_dict(calibration: Calibration, extra: Sequence[Change] = ()) -> 
     return changes_dict([(p.index, p.key, p.value) for p in calibration.estimated], extra)
 
 
-def changes_dict(changes: Sequence[Change], extra: Sequence[Change] = ()) -> Dict[str, Any]:
+def changes_dict(
+    changes: Sequence[Change], extra: Sequence[Change] = (), yaw_rate_multiplier: Optional[float] = None
+) -> Dict[str, Any]:
     """(drive index, key, value) changes in the robot file's shape, with extra besides (a key the
-    changes set wins over the same key in extra)."""
+    changes set wins over the same key in extra), and the yaw-rate multiplier if given."""
     # 9 significant digits: far below any uncertainty, and 0.2016 stays 0.2016 in the file
     values = {(index, key): float(f"{value:.9g}") for index, key, value in changes}
     for index, key, value in extra:
@@ -50,29 +77,57 @@ def changes_dict(changes: Sequence[Change], extra: Sequence[Change] = ()) -> Dic
     drives: Dict[str, Dict[str, float]] = {}
     for (index, key), value in sorted(values.items(), key=lambda item: (item[0][0], _KEY_ORDER.get(item[0][1], 0))):
         drives.setdefault(f"drive{index}", {})[key] = value
-    return {"motor_drives": drives}
+    out: Dict[str, Any] = {"motor_drives": drives}
+    if yaw_rate_multiplier is not None:
+        out["odometry"] = {"yaw_rate_multiplier": float(f"{yaw_rate_multiplier:.9g}")}
+    return out
 
 
-def calibration_yaml(calibration: Calibration, header: str = "", extra: Sequence[Change] = ()) -> str:
+def calibration_yaml(
+    calibration: Calibration,
+    header: str = "",
+    extra: Sequence[Change] = (),
+    yaw_rate_multiplier: Optional[float] = None,
+) -> str:
     """The file's text: an optional comment header (each line prefixed with '# '), then the values."""
-    return changes_yaml([(p.index, p.key, p.value) for p in calibration.estimated], header, extra)
+    changes = [(p.index, p.key, p.value) for p in calibration.estimated]
+    return changes_yaml(changes, header, extra, yaw_rate_multiplier)
 
 
-def changes_yaml(changes: Sequence[Change], header: str = "", extra: Sequence[Change] = ()) -> str:
+def changes_yaml(
+    changes: Sequence[Change],
+    header: str = "",
+    extra: Sequence[Change] = (),
+    yaw_rate_multiplier: Optional[float] = None,
+) -> str:
     """The file's text for (drive index, key, value) changes: as calibration_yaml."""
     comment = "".join(f"# {line}\n" for line in header.splitlines())
-    return comment + yaml.safe_dump(changes_dict(changes, extra), sort_keys=False, default_flow_style=False)
+    data = changes_dict(changes, extra, yaw_rate_multiplier)
+    return comment + yaml.safe_dump(data, sort_keys=False, default_flow_style=False)
 
 
 def load_calibration(path: str, config: RobotConfig) -> List[Change]:
-    """The changes a calibration file makes to the robot of config, checked; ConfigError naming every
-    problem (file, key path, value, rule)."""
-    return parse_calibration(read_yaml_file(path, WHAT), config, path)
+    """The changes a calibration file makes to the robot of config's drives, checked; ConfigError naming
+    every problem (file, key path, value, rule)."""
+    return list(read_calibration(path, config).changes)
+
+
+def read_calibration(path: str, config: RobotConfig) -> CalibrationValues:
+    """Everything a calibration file sets, checked as :func:`load_calibration`."""
+    return parse_calibration_values(read_yaml_file(path, WHAT), config, path)
 
 
 def parse_calibration(data: Any, config: RobotConfig, source: str = "<calibration>") -> List[Change]:
+    return list(parse_calibration_values(data, config, source).changes)
+
+
+def parse_calibration_values(data: Any, config: RobotConfig, source: str = "<calibration>") -> CalibrationValues:
     problems: List[Problem] = []
     data = check_top_level(data, TOP_KEYS, problems, source=source, what=WHAT)
+    multiplier = None
+    if data.get("odometry") is not None:
+        values = parse_entry(data["odometry"], "odometry", ODOMETRY_KEYS, problems)
+        multiplier = (values or {}).get("yaw_rate_multiplier")
     raw = data.get("motor_drives")
     changes: List[Change] = []
     names = [d.name for d in config.drives]
@@ -107,7 +162,7 @@ def parse_calibration(data: Any, config: RobotConfig, source: str = "<calibratio
             problems += [p for p in e.problems if p not in problems]
     if problems:
         raise ConfigError(source, problems, WHAT)
-    return changes
+    return CalibrationValues(tuple(changes), multiplier)
 
 
 def set_drive_params_command(changes: List[Change], namespace: str = "") -> str:
@@ -128,10 +183,14 @@ def _drive_key(name: Any) -> Optional[str]:
 
 __all__ = [
     "KEYS",
+    "ODOMETRY_KEYS",
     "WHAT",
+    "CalibrationValues",
     "calibration_dict",
     "calibration_yaml",
     "load_calibration",
     "parse_calibration",
+    "parse_calibration_values",
+    "read_calibration",
     "set_drive_params_command",
 ]

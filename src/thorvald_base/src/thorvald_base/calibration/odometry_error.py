@@ -51,9 +51,17 @@ def as_read_with(recording: DriveRecording, in_effect: RobotConfig, calibrated: 
     return DriveRecording(recording.t, recording.steering + offset, recording.speed * ratio)
 
 
-def replay(config: RobotConfig, recording: DriveRecording, calculator_for: Callable = load_calculator) -> Path:
-    """base_driver's odometry of the recorded states with this configuration: its pose at each."""
+def replay(
+    config: RobotConfig,
+    recording: DriveRecording,
+    calculator_for: Callable = load_calculator,
+    *,
+    yaw_rate_multiplier: float = 1.0,
+) -> Path:
+    """base_driver's odometry of the recorded states with this configuration (and the calibration's
+    yaw-rate multiplier): its pose at each."""
     calc = calculator_for(config)
+    calc.yaw_rate_multiplier = yaw_rate_multiplier
     poses = np.zeros((len(recording), 3))
     for n, (t, steering, speed) in enumerate(zip(recording.t, recording.steering, recording.speed)):
         pose = calc.calculate_odometry([DriveState(a, v) for a, v in zip(steering, speed)], float(t)).pose
@@ -79,9 +87,11 @@ def odometry_error(
     truth: Union[PoseTruth, GnssTruth],
     heading_bias: float = 0.0,
     calculator_for: Callable = load_calculator,
+    *,
+    yaw_rate_multiplier: float = 1.0,
 ) -> OdometryError:
     """The replayed odometry's distance error and end-point difference against ground truth."""
-    t_odo, x_odo, y_odo, yaw_odo = replay(config, recording, calculator_for)
+    t_odo, x_odo, y_odo, yaw_odo = replay(config, recording, calculator_for, yaw_rate_multiplier=yaw_rate_multiplier)
     t, x, y, yaw = truth_path(truth, heading_bias)
     inside = (t >= t_odo[0]) & (t <= t_odo[-1])
     if np.count_nonzero(inside) < 2:

@@ -10,6 +10,10 @@ of another package does the same and gets the same checks.
 Lifecycle, as pluginlib's: construct with no arguments (or options), ``initialize(drives,
 passive_wheels)`` once, ``set_params(drives, passive_wheels)`` when parameters change at run time
 (the pose is kept), then ``calculate_command`` and ``calculate_odometry`` every cycle.
+
+``yaw_rate_multiplier`` (1 unless a calibration sets it) multiplies the yaw rate odometry reads from the
+drive states, the translation kept: tyres that slip in turns make the wheels' geometry read a turn a
+little short, as diff_drive_controller's ``wheel_separation_multiplier`` corrects for skid steering.
 """
 
 import math
@@ -25,6 +29,7 @@ from .types import CommandResult, DriveCommand, DriveState, OdometryResult, Pose
 
 MAX_ODOMETRY_DT = 0.5  # [s]: a longer gap between states is a pause, not motion (the original's rule)
 STOPPED_SPEED = 1e-9  # [m/s]: a wheel this slow has no direction of its own; it keeps its heading
+YAW_RATE_MULTIPLIER_RANGE = (0.9, 1.1)  # a tyre slips a turn short by a few per mille, never 10 %
 REALISABLE_TOLERANCE = 1e-9  # [m/s]: wheel-velocity change below which a twist counts as unchanged
 
 
@@ -52,6 +57,7 @@ class BaseCalculator:
         self._last_steering: List[float] = []
         self._pose = Pose()
         self._last_time: Optional[float] = None
+        self._yaw_rate_multiplier = 1.0
 
     # ---- the original's interface ---------------------------------------------------------
     def initialize(self, drives: Sequence, passive_wheels: Sequence = ()) -> None:
@@ -120,6 +126,7 @@ class BaseCalculator:
         steering = [s.steering for s in states]
         speed = [s.speed for s in states]
         vx, vy, wz, res, translating = self._estimator.estimate(steering, speed)
+        wz *= self._yaw_rate_multiplier
         twist = Twist(vx, vy, wz)
         if not all(math.isfinite(v) for v in (vx, vy, wz)):
             return OdometryResult(twist, self._pose, res, dt, False, translating)
@@ -134,7 +141,7 @@ class BaseCalculator:
         nothing: what a calibration compares with ground truth."""
         self._require()
         vx, vy, wz, _, _ = self._estimator.estimate(list(steering), list(speed))
-        return Twist(vx, vy, wz)
+        return Twist(vx, vy, wz * self._yaw_rate_multiplier)
 
     # ---- conveniences ---------------------------------------------------------------------
     @classmethod
@@ -150,6 +157,19 @@ class BaseCalculator:
 
     def set_pose(self, pose: Pose) -> None:
         self._pose = pose
+
+    @property
+    def yaw_rate_multiplier(self) -> float:
+        return self._yaw_rate_multiplier
+
+    @yaw_rate_multiplier.setter
+    def yaw_rate_multiplier(self, value: float) -> None:
+        """The factor on odometry's yaw rate, from the next odometry on; KinematicsError unless within
+        YAW_RATE_MULTIPLIER_RANGE (beyond it the robot file's geometry is wrong, not the tyres' grip)."""
+        low, high = YAW_RATE_MULTIPLIER_RANGE
+        if isinstance(value, bool) or not (isinstance(value, (int, float)) and low <= value <= high):
+            raise KinematicsError(f"yaw_rate_multiplier must be in [{low:g}, {high:g}], not {value!r}")
+        self._yaw_rate_multiplier = float(value)
 
     def wheel_velocity(self, twist: Twist, index: int):
         """Velocity (vx, vy) [m/s] the twist gives drive index's wheel contact."""
