@@ -77,6 +77,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4, 5])
     parser.add_argument("--robot", default="thorvald_ii_6wd6ws_asym")
+    parser.add_argument("--json", metavar="FILE", help="also write every figure as JSON to FILE")
     args = parser.parse_args()
     rows, missed = [], []
     with tempfile.TemporaryDirectory() as tmp:
@@ -119,13 +120,25 @@ def main() -> int:
     for seed, runs, tyres, multiplier in rows:
         cells = [" / ".join(cell(runs[k][a]) for a in ("against_truth", "against_rtk_gnss")) for k in runs]
         cells.insert(4, f"{multiplier:.5f}")
-        tyre = ", ".join(f"{tyres[k]['largest_percent']:.2f} %" for k in ("ground_truth", "balanced", "calibration"))
+        tyre = ", ".join(
+            f"{tyres[k]['largest_percent']:.2f} ({tyres[k]['largest_relative_percent']:.2f}) %"
+            for k in ("ground_truth", "balanced", "calibration")
+        )
         print(f"| field:{seed} | " + " | ".join(cells) + f" | {tyre} |")
     print(
         "(before the turns: the calibration without its yaw-rate multiplier; as built's own: the as-built robot's "
         "radii and offsets in effect, no multiplier; tyres: the largest error of a tyre's radius against the as-built "
-        "robot's)"
+        "robot's, and in brackets against the others only, the common factor taken out)"
     )
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(
+                [
+                    {"seed": seed, "runs": runs, "tyres": tyres, "yaw_rate_multiplier": m}
+                    for seed, runs, tyres, m in rows
+                ],
+                f,
+            )
     if missed:
         print(f"targets (distance {DISTANCE} %, end {END} m, tyres {TYRE} %) missed: " + "; ".join(missed))
         return 1

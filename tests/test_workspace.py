@@ -180,7 +180,8 @@ def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determi
     truth. Then its wheels balanced from their motor currents: they stop fighting, and each tyre's
     radius against the others' comes within the issue's 0.3 % of the as-built robot's, where ground
     truth left it 0.9 % off. Then straight legs at working speed with that in effect give the radii's
-    common factor, and the calibration reads their distance right. Last, U turns of the working radius
+    common factor and odometry's yaw per metre, and the calibration reads their distance and heading right.
+    Last, U turns of the working radius
     give odometry's yaw-rate multiplier: its tyres slip in a turn, and the turns read short without it."""
     out = os.path.join(WS, "build", "calibration_drive")
     with open(os.path.join(out, "result.json")) as f:
@@ -207,8 +208,11 @@ def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determi
     assert 0.995 < straight["scale"]["factor"] < 1.01 and straight["scale"]["sd"] < 0.001
     assert abs(straight["after"]["distance_error_percent"]) < 0.05 < abs(straight["before"]["distance_error_percent"])
     assert os.path.samefile(straight["calibration_file"], os.path.join(out, "scaled_calibration.yaml"))
+    heading = straight["scale"]["yaw_per_metre"]  # the turn odometry reads on a straight leg, taken out
+    assert abs(heading["value"]) < 0.005 and max(abs(a) for a in heading["odometry_turn_after_rad"]) < 0.002
     turns = result["turns"]
     assert len(turns["turns"]) == 8 and turns["yaw_rate_multiplier"]["in_effect"] == 1.0
+    assert turns["yaw_per_metre"] == heading["value"]  # the straight legs' correction in effect
     short = [1 - t["odometry_rad"] / t["truth_rad"] for t in turns["turns"]]
     assert all(0.0 < s < 0.02 for s in short)  # every turn read short, by a few per mille
     multiplier = turns["yaw_rate_multiplier"]["value"]

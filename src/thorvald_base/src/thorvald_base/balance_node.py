@@ -135,7 +135,7 @@ class BalanceDrive(VerificationDrive):
                 "the other values as the calibration it started with"
             )
             with open(self.out, "w") as f:
-                f.write(changes_yaml(changes, header, self.calibration, self.in_effect.yaw_rate_multiplier))
+                f.write(changes_yaml(changes, header, self.calibration, self.in_effect.odometry))
             text += f"\nwrote {os.path.abspath(self.out)}"
         if self.json:
             with open(self.json, "w") as f:

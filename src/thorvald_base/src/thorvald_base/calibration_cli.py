@@ -54,6 +54,7 @@ from .calibration.observable import FAR, along_undetermined
 from .calibration.turns import TurnFit, turn_fit
 from .conversions import quaternion_yaw
 from .errors import CalibrationError, ThorvaldBaseError
+from .kinematics.calculator import NO_CORRECTION
 
 ENDINGS = {"states": "base_state", "truth": "odometry/gazebo", "fix": "gps/fix", "imu": "imu/data"}
 EXIT_ERROR = 2
@@ -168,12 +169,13 @@ def parse_args(argv: Optional[List[str]]):
     )
     parser.add_argument(
         "--fit",
-        choices=("drives", "odometry", "scale", "turns"),
+        choices=("drives", "odometry", "scale", "straight", "turns"),
         default="drives",
         help="drives: each drive's radius and offset from its own wheel's motion (the default); odometry: only "
         "the combinations the drive determines through the odometry, the rest kept at the values in effect "
         "(the simulator's ground truth); scale: only the radii's common factor, from straight legs between "
-        "standstills (the straight manoeuvre, driven with the calibration in effect); turns: only odometry's "
+        "standstills (the straight manoeuvre, driven with the calibration in effect); straight: the same legs' "
+        "common factor and odometry's yaw per metre, from the legs' heading; turns: only odometry's "
         "yaw-rate multiplier, from U turns of the working radius (the turns manoeuvre, driven with the "
         "calibration in effect)",
     )
@@ -202,23 +204,25 @@ def run(args) -> int:
     if not args.window > 0:
         raise CalibrationError(f"--window: {args.window!r}: must be > 0 [s]")
     robot = load_robot_config(args.robot_model)
-    in_effect, earlier, multiplier = robot, [], None
+    in_effect, earlier, odometry = robot, [], None
     if args.calibration:
         values = read_calibration(args.calibration, robot)
-        earlier, multiplier = list(values.changes), values.yaw_rate_multiplier
+        earlier, odometry = list(values.changes), values.odometry
         for index, key, value in earlier:
             in_effect = in_effect.with_drive_param(index, key, value)
-    if args.fit in ("scale", "turns") and args.balance:
+    if args.fit in ("scale", "straight", "turns") and args.balance:
         raise CalibrationError(
             f"--balance goes with --fit drives or odometry: --fit {args.fit} keeps every radius's share"
         )
     recording, truth, said, namespace = read_bag(args.bag, len(robot.drives), args.ground_truth, args.antenna)
     if args.fit == "turns":
-        return run_turns(args, in_effect, recording, truth, said=said, earlier=earlier, multiplier=multiplier)
-    yaw_rate = 1.0 if multiplier is None else multiplier
+        return run_turns(args, in_effect, recording, truth, said=said, earlier=earlier, odometry=odometry)
+    correction = odometry or NO_CORRECTION
     scale = None
-    if args.fit == "scale":
-        scale = common_scale(in_effect, recording, truth)
+    if args.fit in ("scale", "straight"):
+        scale = common_scale(in_effect, recording, truth, heading=args.fit == "straight", in_effect=correction)
+        if args.fit == "straight":
+            odometry = scale.correction
         calibration, observable = scale.calibration(in_effect), None
     elif args.fit == "odometry":
         if not isinstance(truth, PoseTruth):
@@ -234,12 +238,12 @@ def run(args) -> int:
         calibration = with_balance(calibration, observable, list(read_calibration(args.balance, robot).changes), robot)
     calibrated = calibration.calibrated(in_effect)
     bias = calibration.heading_bias[0] if calibration.heading_bias else 0.0
-    before = odometry_error(in_effect, recording, truth, bias, yaw_rate_multiplier=yaw_rate)
+    before = odometry_error(in_effect, recording, truth, bias, correction=correction)
     after = odometry_error(
-        calibrated, as_read_with(recording, in_effect, calibrated), truth, bias, yaw_rate_multiplier=yaw_rate
+        calibrated, as_read_with(recording, in_effect, calibrated), truth, bias, correction=odometry or NO_CORRECTION
     )
     out = args.out or default_out(args)
-    kept = write_file(out, calibration, earlier, args, said, multiplier=multiplier)
+    kept = write_file(out, calibration, earlier, args, said, odometry=odometry)
     outcome = Outcome(
         calibration,
         said,
@@ -300,19 +304,18 @@ def default_out(args) -> str:
     return os.path.join(os.path.dirname(os.path.abspath(args.bag)), "calibration.yaml")
 
 
-def run_turns(args, in_effect, recording, truth, *, said: str, earlier, multiplier: Optional[float]) -> int:
+def run_turns(args, in_effect, recording, truth, *, said: str, earlier, odometry) -> int:
     """--fit turns: the yaw-rate multiplier from the drive's turns, every drive value kept."""
-    in_use = 1.0 if multiplier is None else multiplier
-    fit = turn_fit(in_effect, recording, truth, in_use)
+    fit = turn_fit(in_effect, recording, truth, odometry or NO_CORRECTION)
     # as --fit scale: GNSS's end point taken with the IMU's yaw as it reads (its bias is not estimated here)
-    before = odometry_error(in_effect, recording, truth, yaw_rate_multiplier=in_use)
-    after = odometry_error(in_effect, recording, truth, yaw_rate_multiplier=fit.multiplier)
+    before = odometry_error(in_effect, recording, truth, correction=fit.in_effect)
+    after = odometry_error(in_effect, recording, truth, correction=fit.correction)
     out = args.out or default_out(args)
     header = header_lines(args, out, said)
     header += f"\nthe yaw-rate multiplier from {len(fit.turns)} turns"
     if earlier:
         header += f"; the drives' values kept from {args.calibration}"
-    write_text(out, changes_yaml([], header, extra=earlier, yaw_rate_multiplier=fit.multiplier))
+    write_text(out, changes_yaml([], header, extra=earlier, odometry=fit.correction))
     if args.json:
         print(json.dumps(turns_json(fit, said, before, after, out), indent=2))
     else:
@@ -343,7 +346,12 @@ def turns_json(fit: TurnFit, said: str, before: OdometryError, after: OdometryEr
             {"start": turn.start, "end": turn.end, "truth_rad": turn.truth, "odometry_rad": turn.odometry}
             for turn in fit.turns
         ],
-        "yaw_rate_multiplier": {"value": fit.multiplier, "sd": _number(fit.multiplier_sd), "in_effect": fit.in_effect},
+        "yaw_rate_multiplier": {
+            "value": fit.multiplier,
+            "sd": _number(fit.multiplier_sd),
+            "in_effect": fit.in_effect.yaw_rate_multiplier,
+        },
+        "yaw_per_metre": fit.in_effect.yaw_per_metre,
         "before": _errors(before),
         "after": _errors(after),
         "calibration_file": path,
@@ -360,7 +368,7 @@ def print_turns(fit: TurnFit, said: str, errors: Tuple[OdometryError, OdometryEr
         )
     print(
         f"odometry's yaw-rate multiplier: {fit.multiplier:.5f} ± {fit.multiplier_sd:.5f} "
-        f"(was {fit.in_effect:g}; the turns read {100 * (fit.gain - 1):+.3f} % short with it)"
+        f"(was {fit.in_effect.yaw_rate_multiplier:g}; the turns read {100 * (fit.gain - 1):+.3f} % short with it)"
     )
     print(
         f"odometry against ground truth: before {before.distance_error_percent:+.3f} % of "
@@ -371,16 +379,15 @@ def print_turns(fit: TurnFit, said: str, errors: Tuple[OdometryError, OdometryEr
     print("base_driver applies it at start (~calibration); set_drive_params does not change the multiplier")
 
 
-def write_file(path: str, calibration: Calibration, earlier, args, said: str, *, multiplier=None) -> bool:
-    """The estimates, over the calibration in effect (what was not estimated again is kept from it, the
-    yaw-rate multiplier too)."""
+def write_file(path: str, calibration: Calibration, earlier, args, said: str, *, odometry=None) -> bool:
+    """The estimates, over the calibration in effect (what was not estimated again is kept from it), and
+    odometry's correction (kept, or with what was fitted)."""
     estimated = {(p.index, p.key) for p in calibration.estimated}
     kept = [(i, key, value) for i, key, value in earlier if (i, key) not in estimated]
     header = header_lines(args, path, said)
-    if kept or multiplier is not None:
-        names = [f"drive{i} {key}" for i, key, _ in kept] + (["yaw_rate_multiplier"] if multiplier is not None else [])
-        header += f"\nkept from {args.calibration}: " + ", ".join(names)
-    text = calibration_yaml(calibration, header, extra=kept, yaw_rate_multiplier=multiplier)
+    if kept:
+        header += f"\nkept from {args.calibration}: " + ", ".join(f"drive{i} {key}" for i, key, _ in kept)
+    text = calibration_yaml(calibration, header, extra=kept, odometry=odometry)
     write_text(path, text)
     return bool(kept)
 
@@ -413,10 +420,24 @@ def as_json(outcome: Outcome) -> dict:
             "factor": outcome.scale.factor,
             "sd": _number(outcome.scale.sd),
             "legs": [
-                {"truth_m": leg.truth_m, "odometry_m": leg.odometry_m, "path_m": leg.path_m, "straight": leg.straight}
+                {
+                    "truth_m": leg.truth_m,
+                    "odometry_m": leg.odometry_m,
+                    "path_m": leg.path_m,
+                    "straight": leg.straight,
+                    "truth_turn_rad": leg.truth_turn,
+                    "odometry_turn_rad": leg.odometry_turn,
+                }
                 for leg in outcome.scale.legs
             ],
         }
+        if outcome.scale.yaw_per_metre is not None:
+            out["scale"]["yaw_per_metre"] = {
+                "added": outcome.scale.yaw_per_metre,
+                "sd": _number(outcome.scale.yaw_per_metre_sd),
+                "value": outcome.scale.correction.yaw_per_metre,
+                "odometry_turn_after_rad": list(outcome.scale.odometry_turns_after),
+            }
     if outcome.observable is not None:
         out["combinations"] = [
             {
@@ -459,6 +480,17 @@ def print_text(outcome: Outcome) -> None:
             f"odometry's {sum(leg.odometry_m for leg in used):.2f} m"
             + (f"; {left} legs left out (turned or short)" if left else "")
         )
+        if scale.yaw_per_metre is not None:
+            print(
+                f"odometry's yaw per metre along x: {scale.correction.yaw_per_metre:+.6f} rad/m "
+                f"({math.degrees(scale.yaw_per_metre):+.4f} ± {math.degrees(scale.yaw_per_metre_sd):.4f} deg/m added); "
+                "each leg's heading change [deg], ground truth / odometry before / after: "
+                + ", ".join(
+                    f"{math.degrees(leg.truth_turn):+.2f} / {math.degrees(leg.odometry_turn):+.2f} / "
+                    f"{math.degrees(after):+.2f}"
+                    for leg, after in zip(used, scale.odometry_turns_after)
+                )
+            )
     print(f"{'drive':<8} {'r_wheel [m]':<34} steering_offset [rad]")
     rows: Dict[str, Dict[str, str]] = {}
     for p in calibration.parameters:

@@ -10,7 +10,7 @@ first instant is a cycle too, as there are no commands yet to answer it with.
 thorvald_sim's runner in the same process as the simulation.
 
 :func:`apply_calibration` is base_driver's ``~calibration``: the file's values checked against the
-robot and applied as ``set_drive_params`` applies them, its yaw-rate multiplier to the calculator.
+robot and applied as ``set_drive_params`` applies them, its odometry correction to the calculator.
 
 Pure: no rospy.
 """
@@ -19,7 +19,7 @@ from typing import Optional, Tuple
 
 from .calibration.calibration_file import CalibrationValues, read_calibration
 from .core import BaseDriverCore, CycleResult
-from .errors import ParameterError
+from .errors import KinematicsError, ParameterError
 from .rate_grid import RateGrid
 
 Twist3 = Tuple[float, float, float]  # vx [m/s], vy [m/s], wz [rad/s]
@@ -61,20 +61,24 @@ class LockstepCycles:
 
 def apply_calibration(core: BaseDriverCore, path: str) -> CalibrationValues:
     """A calibration file's values (calibrate_odometry writes it), checked against the core's robot
-    and applied: the drives' through set_drive_params, the yaw-rate multiplier to the calculator's
-    odometry; what it set. ConfigError for a broken file, ParameterError for values the robot refuses."""
+    and applied: the drives' through set_drive_params, the odometry correction to the calculator; what
+    it set. ConfigError for a broken file, ParameterError for values the robot refuses."""
     values = read_calibration(path, core.config)
     _, problems = core.set_drive_params(list(values.changes))
     if problems:
         raise ParameterError(f"~calibration: {path}: " + "; ".join(problems))
-    if values.yaw_rate_multiplier is not None:
-        core.calculator.yaw_rate_multiplier = values.yaw_rate_multiplier
+    if values.odometry is not None:
+        try:
+            core.calculator.odometry_correction = values.odometry
+        except KinematicsError as e:  # the file's rules are the calculator's: a floor for direct users
+            raise ParameterError(f"~calibration: {path}: {e}") from None
     return values
 
 
 def calibration_said(values: CalibrationValues) -> str:
     """What a calibration file set, in a few words (base_driver logs it)."""
     said = [f"drive{i} {key} {value:g}" for i, key, value in values.changes]
-    if values.yaw_rate_multiplier is not None:
-        said.append(f"odometry yaw_rate_multiplier {values.yaw_rate_multiplier:g}")
+    for key in ("yaw_rate_multiplier", "yaw_per_metre"):
+        if getattr(values, key) is not None:
+            said.append(f"odometry {key} {getattr(values, key):g}")
     return ", ".join(said) or "nothing to change"

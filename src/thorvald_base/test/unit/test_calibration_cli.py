@@ -216,6 +216,29 @@ def test_fit_scale_takes_the_radii_common_factor_from_straight_legs_over_the_cal
         assert status == 2 and err.count("\n") == 1 and message in err, err
 
 
+def test_fit_straight_also_takes_odometrys_yaw_per_metre_from_the_legs_heading(tmp_path, capsys, std):
+    from thorvald_base.calibration.calibration_file import read_calibration  # noqa: PLC0415
+    from thorvald_base.verification import plan_named  # noqa: PLC0415
+
+    truth = [d.r_wheel * math.exp(0.002 * d.y) for d in std.drives]  # the left tyres 0.18 % larger
+    plan = [(s.duration, s.twist) for s in plan_named("straight", std, side=3.0)[1]]
+    bag = write_bag(tmp_path / "straight.bag", synthetic_drive(std, plan, truth, [0.0] * 4))
+    earlier = tmp_path / "earlier.yaml"
+    earlier.write_text("odometry: {yaw_rate_multiplier: 1.004}\n")
+    status, out, err = run(capsys, bag, "--robot-model", STD, "--fit", "straight", "--calibration", earlier, "--json")
+    assert status == 0, err
+    heading = json.loads(out)["scale"]["yaw_per_metre"]
+    assert heading["value"] == heading["added"] and 1e-4 < abs(heading["value"]) < 1e-3
+    assert max(abs(t) for t in heading["odometry_turn_after_rad"]) < 1e-5
+    values = read_calibration(str(tmp_path / "calibration.yaml"), std)  # the multiplier in effect kept
+    assert values.odometry.yaw_rate_multiplier == 1.004
+    assert values.odometry.yaw_per_metre == pytest.approx(heading["value"], rel=1e-6)
+    status, out, err = run(capsys, bag, "--robot-model", STD, "--fit", "straight")
+    assert status == 0, err
+    assert re.search(r"odometry's yaw per metre along x: [+-]0\.000[0-9]+ rad/m \([+-]0\.0[0-9]+ ± 0\.0000 deg/m", out)
+    assert "each leg's heading change [deg], ground truth / odometry before / after: +0.00 / " in out
+
+
 def test_fit_turns_takes_the_yaw_rate_multiplier_from_the_turns_over_the_calibration_in_effect(tmp_path, capsys, std):
     from calibration_test_helpers import with_turn_slip  # noqa: PLC0415
 
@@ -239,14 +262,14 @@ def test_fit_turns_takes_the_yaw_rate_multiplier_from_the_turns_over_the_calibra
     )
     values = read_calibration(str(tmp_path / "calibration.yaml"), std)
     assert values.changes == ((1, "r_wheel", 0.205),)  # the drives' values kept
-    assert values.yaw_rate_multiplier == pytest.approx(1.005, abs=1e-6)
+    assert values.yaw_rate_multiplier == pytest.approx(1.005, abs=1e-6) and values.yaw_per_metre == 0.0
     # from the IMU's yaw, as JSON
     status, out, err = run(capsys, bag, "--robot-model", STD, "--fit", "turns", "--ground-truth", "gnss", "--json")
     assert status == 0, err
     result = json.loads(out)
     assert result["fit"] == "turns" and len(result["turns"]) == 8
     assert result["yaw_rate_multiplier"]["value"] == pytest.approx(1.005, abs=1e-6)
-    assert result["yaw_rate_multiplier"]["in_effect"] == 1.0
+    assert result["yaw_rate_multiplier"]["in_effect"] == 1.0 and result["yaw_per_metre"] == 0.0
     # a drive without turns, and --balance, are refused in one line
     straight = write_bag(tmp_path / "straight.bag", synthetic_drive(std, STRAIGHT, RADII, OFFSETS))
     for bag_, extra, message in (

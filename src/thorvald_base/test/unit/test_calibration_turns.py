@@ -12,7 +12,7 @@ from thorvald_base.calibration import odometry_error
 from thorvald_base.calibration.calibration_file import changes_yaml, parse_calibration_values, read_calibration
 from thorvald_base.calibration.turns import turn_fit
 from thorvald_base.errors import CalibrationError, KinematicsError
-from thorvald_base.kinematics import DriveState, Twist
+from thorvald_base.kinematics import DriveState, OdometryCorrection, Twist
 from thorvald_base.plugins import load_calculator
 from thorvald_base.verification import ROW_SPACING, commanded_path, plan_named
 from thorvald_model.errors import ConfigError
@@ -58,11 +58,11 @@ def test_the_multiplier_is_ground_truths_turn_over_odometrys_and_the_turns_both_
     # the two ways differ by 0.4 %: their scatter (0.2 % a turn) over the eight turns is the uncertainty
     assert fit.multiplier_sd == pytest.approx(0.002 / math.sqrt(7), rel=0.02)
     # with the multiplier in effect the turns read right and the fit says so: no further gain
-    again = turn_fit(config, drive.recording, drive.pose_truth, in_effect=fit.multiplier)
+    again = turn_fit(config, drive.recording, drive.pose_truth, in_effect=fit.correction)
     assert again.gain == pytest.approx(1.0, abs=1e-6) and again.multiplier == pytest.approx(fit.multiplier)
     # the drive's end point comes in as far as one multiplier for both ways can bring it; the distance stays
     before = odometry_error(config, drive.recording, drive.pose_truth)
-    after = odometry_error(config, drive.recording, drive.pose_truth, yaw_rate_multiplier=fit.multiplier)
+    after = odometry_error(config, drive.recording, drive.pose_truth, correction=fit.correction)
     assert before.end_point_m > 0.1 and after.end_point_m < before.end_point_m * 0.75
     assert after.distance_error_percent == pytest.approx(before.distance_error_percent, abs=1e-5)
     # where both ways slip alike, it takes the end point to where the 20 ms steps leave it
@@ -70,7 +70,7 @@ def test_the_multiplier_is_ground_truths_turn_over_odometrys_and_the_turns_both_
     fit = turn_fit(config, alike.recording, alike.pose_truth)
     assert fit.multiplier == pytest.approx(1.006, abs=1e-6)
     before = odometry_error(config, alike.recording, alike.pose_truth)
-    after = odometry_error(config, alike.recording, alike.pose_truth, yaw_rate_multiplier=fit.multiplier)
+    after = odometry_error(config, alike.recording, alike.pose_truth, correction=fit.correction)
     assert before.end_point_m > 0.1 and after.end_point_m < 1e-3
 
 
@@ -87,38 +87,53 @@ def test_the_imus_yaw_is_ground_truth_enough_and_a_drive_without_turns_is_refuse
         turn_fit(config, absurd.recording, absurd.pose_truth)
 
 
-def test_the_calculator_multiplies_odometrys_yaw_rate_and_keeps_its_translation():
+def test_the_calculator_corrects_odometrys_yaw_rate_and_keeps_its_translation():
     config = four_ws()
     calc = load_calculator(config)
     command = calc.calculate_command(Twist(0.75, 0.0, 1.0)).commands
     states = [DriveState(c.steering, c.speed) for c in command]
     plain = calc.calculate_odometry(states, 0.0).twist
-    calc.yaw_rate_multiplier = 1.006
-    scaled = calc.calculate_odometry(states, 0.02)
-    assert scaled.twist.wz == pytest.approx(plain.wz * 1.006) and scaled.twist.vx == pytest.approx(plain.vx)
-    assert scaled.pose.yaw == pytest.approx(0.02 * 1.006)  # integrated with it
-    assert calc.body_twist([s.steering for s in states], [s.speed for s in states]).wz == pytest.approx(1.006)
+    correction = OdometryCorrection(1.006, 0.002)
+    calc.odometry_correction = correction
+    fixed = calc.calculate_odometry(states, 0.02)
+    assert fixed.twist.wz == pytest.approx(plain.wz * 1.006 + 0.002 * 0.75)
+    assert (fixed.twist.vx, fixed.twist.vy) == pytest.approx((plain.vx, plain.vy))
+    assert fixed.pose.yaw == pytest.approx(0.02 * (1.006 + 0.0015))  # integrated with it
+    twist = calc.body_twist([s.steering for s in states], [s.speed for s in states])
+    assert twist.wz == pytest.approx(1.006 + 0.0015)
     calc.set_params(config.drives)  # a new radius at run time keeps it
-    assert calc.yaw_rate_multiplier == 1.006
-    for bad in (1.2, 0.5, float("nan"), True, "1"):
-        with pytest.raises(KinematicsError, match=r"yaw_rate_multiplier must be in \[0\.9, 1\.1\]"):
-            calc.yaw_rate_multiplier = bad
-    assert calc.yaw_rate_multiplier == 1.006
+    assert calc.odometry_correction == correction
+    cases = [
+        (OdometryCorrection(1.2), r"yaw_rate_multiplier must be in \[0\.9, 1\.1\], not 1\.2"),
+        (OdometryCorrection(float("nan")), "yaw_rate_multiplier must be in"),
+        (OdometryCorrection(True), "yaw_rate_multiplier must be in"),
+        (OdometryCorrection(1.0, 0.01), r"yaw_per_metre must be within \+-0\.005 rad/m, not 0\.01"),
+        (OdometryCorrection(1.0, "0"), "yaw_per_metre must be within"),
+    ]
+    for bad, said in cases:
+        with pytest.raises(KinematicsError, match=said):
+            calc.odometry_correction = bad
+    assert calc.odometry_correction == correction
 
 
 def test_the_calibration_file_carries_the_multiplier_and_names_a_bad_one(tmp_path):
     config = four_ws()
     path = tmp_path / "calibration.yaml"
-    path.write_text(changes_yaml([(1, "r_wheel", 0.201)], "a header", yaw_rate_multiplier=1.00612345678))
-    assert "odometry:\n  yaw_rate_multiplier: 1.00612346\n" in path.read_text()
+    path.write_text(
+        changes_yaml([(1, "r_wheel", 0.201)], "a header", odometry=OdometryCorrection(1.00612345678, -2e-4))
+    )
+    assert "odometry:\n  yaw_rate_multiplier: 1.00612346\n  yaw_per_metre: -0.0002\n" in path.read_text()
     values = read_calibration(str(path), config)
-    assert values.changes == ((1, "r_wheel", 0.201),) and values.yaw_rate_multiplier == 1.00612346
-    assert parse_calibration_values({"motor_drives": {}}, config).yaw_rate_multiplier is None
+    assert values.changes == ((1, "r_wheel", 0.201),) and values.odometry == OdometryCorrection(1.00612346, -2e-4)
+    assert parse_calibration_values({"motor_drives": {}}, config).odometry is None
+    alone = parse_calibration_values({"odometry": {"yaw_per_metre": 0.001}}, config)
+    assert (alone.yaw_rate_multiplier, alone.odometry) == (None, OdometryCorrection(1.0, 0.001))
     cases = [
         ({"odometry": {"yaw_rate_multiplier": 1.5}}, "odometry.yaw_rate_multiplier: 1.5: must be in [0.9, 1.1]"),
         ({"odometry": {"yaw_rate": 1.0}}, "odometry.yaw_rate: 1.0: unknown key"),
         ({"odometry": [1.0]}, "odometry: [1.0]: must be a mapping of keys"),
         ({"odometry": {"yaw_rate_multiplier": "fast"}}, "odometry.yaw_rate_multiplier: 'fast'"),
+        ({"odometry": {"yaw_per_metre": -0.02}}, "odometry.yaw_per_metre: -0.02: must be within +-0.005 rad/m"),
     ]
     for data, said in cases:
         with pytest.raises(ConfigError) as e:
@@ -136,6 +151,7 @@ def test_base_drivers_core_applies_the_files_multiplier_to_its_odometry(tmp_path
     path = tmp_path / "calibration.yaml"
     path.write_text("motor_drives:\n  drive0: {r_wheel: 0.201}\nodometry: {yaw_rate_multiplier: 0.997}\n")
     values = apply_calibration(core, str(path))
-    assert core.calculator.yaw_rate_multiplier == 0.997 and core.config.drives[0].r_wheel == 0.201
+    assert core.calculator.odometry_correction == OdometryCorrection(0.997, 0.0)
+    assert core.config.drives[0].r_wheel == 0.201
     assert calibration_said(values) == "drive0 r_wheel 0.201, odometry yaw_rate_multiplier 0.997"
     assert np.isfinite(core.step(0.0).odometry.twist.wz)

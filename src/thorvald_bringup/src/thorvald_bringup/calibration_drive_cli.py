@@ -18,7 +18,8 @@ A robot of more than two drives (whose wheels can fight on one rigid frame) goes
 sets each tyre's radius against the others' from the motors' currents (balanced.yaml); the
 calibration drive's fit is taken again with it (``calibrate_odometry --balance``,
 balanced_calibration.yaml); and the straight manoeuvre, driven at working speed with that in effect,
-gives the radii's common factor (``calibrate_odometry --fit scale``): scaled_calibration.yaml.
+gives the radii's common factor and odometry's yaw per metre, the turn it reads on a straight line that
+the frame does not make (``calibrate_odometry --fit straight``): scaled_calibration.yaml.
 
 Last, unless ``--no-turns``, the turns manoeuvre (the field route's headland U turns, twice each way,
 twice) is driven with all that in effect, and odometry's yaw-rate multiplier fitted to its turns
@@ -205,11 +206,11 @@ def run(args) -> int:
     straight_bag = os.path.join(out, STRAIGHT_BAG)
     with_fit = argparse.Namespace(**{**vars(args), "calibration": balanced_fit})
     wall, _ = drive(with_fit, model, straight_bag, "straight", args.side, log="straight")
-    scale = [straight_bag, "--robot-model", model, "--out", scaled, "--calibration", balanced_fit, "--fit", "scale"]
+    scale = [straight_bag, "--robot-model", model, "--out", scaled, "--calibration", balanced_fit, "--fit", "straight"]
     scale += ["--ground-truth", args.ground_truth, *(["--json"] if args.json else [])]
     if not args.json:
         print(f"  drive: {wall:.1f} s wall; bag {straight_bag}", flush=True)
-        print("\nthe radii's common factor from the straight legs, that calibration in effect:")
+        print("\nthe radii's common factor and odometry's yaw per metre from the straight legs, that in effect:")
     captured = io.StringIO()
     with contextlib.redirect_stdout(captured):
         status = calibrate_odometry(scale)

@@ -240,11 +240,11 @@ def run(args) -> int:
     built = as_built_for(args.as_built, config)  # refused here, before anything starts
     if args.as_built and args.as_built.partition(":")[0] not in PROFILES:
         args.as_built = os.path.abspath(args.as_built)  # the spawn runs elsewhere (in ~/.ros)
-    multiplier = 1.0
+    correction = None
     if args.calibration:  # refused here too, as base_driver would refuse it
         from thorvald_base.calibration.calibration_file import read_calibration  # noqa: PLC0415
 
-        multiplier = read_calibration(args.calibration, config).yaw_rate_multiplier or 1.0
+        correction = read_calibration(args.calibration, config).odometry
     if not 1 <= args.physics_workers <= MAX_WORKERS:
         raise ThorvaldBringupError(f"--physics-workers: {args.physics_workers}: must be in 1..{MAX_WORKERS}")
     out = os.path.abspath(args.out)
@@ -277,7 +277,8 @@ def run(args) -> int:
         )
     calculators = {e: load_calculator(config, estimator=e, seed=PAPER_SEED) for e in ("lsq", "paper")}
     for calculator in calculators.values():  # base_state is what base_driver read with the calibration in effect;
-        calculator.yaw_rate_multiplier = multiplier  # its odometry had the calibration's multiplier too
+        if correction is not None:  # its odometry had the calibration's correction too
+            calculator.odometry_correction = correction
     report = make_report(recording, calculators)
     if wall is not None or args.plan:
         report.planned_distance = commanded_path(plan_named(args.manoeuvre, config)[1])[1]

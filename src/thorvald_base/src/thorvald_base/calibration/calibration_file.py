@@ -5,11 +5,13 @@
       drive2: {r_wheel: 0.19874}
     odometry:
       yaw_rate_multiplier: 1.0061
+      yaw_per_metre: 0.00021
 
 Any drive key set_drive_params may change (thorvald_model's RUNTIME_DRIVE_KEYS) may be given; base_driver
 applies the file through set_drive_params, so each value is checked as the robot file's is.
-``odometry.yaw_rate_multiplier`` (``calibrate_odometry --fit turns``) multiplies the yaw rate odometry
-reads (the calculator's ``yaw_rate_multiplier``): turns of the working radius read as truth turns them. Reading it
+``odometry`` is the calculator's :class:`OdometryCorrection` of the yaw rate odometry reads:
+``yaw_rate_multiplier`` (``calibrate_odometry --fit turns``: turns of the working radius read as ground
+truth turns them) and ``yaw_per_metre`` [rad/m] (``--fit straight``: straight legs read straight). Reading it
 (:func:`load_calibration`) checks it first against the robot it is for, with the robot file's loader
 helpers, and reports every problem with this file's name, the key path, the value and the rule.
 
@@ -27,7 +29,7 @@ from thorvald_model.keys import DRIVE_KEYS
 from thorvald_model.schema import Key, check_top_level, parse_entry, read_yaml_file
 from thorvald_model.values import RobotConfig
 
-from ..kinematics.calculator import YAW_RATE_MULTIPLIER_RANGE
+from ..kinematics.calculator import MAX_YAW_PER_METRE, YAW_RATE_MULTIPLIER_RANGE, OdometryCorrection
 from .estimate import Calibration
 
 WHAT = "calibration file"
@@ -45,15 +47,31 @@ ODOMETRY_KEYS = (
         f"must be in [{_LOW:g}, {_HIGH:g}] (a turn read a few per mille short is tyre slip; 10 % is a wrong robot "
         "file)",
     ),
+    Key(
+        "yaw_per_metre",
+        float,
+        None,
+        lambda v: abs(v) <= MAX_YAW_PER_METRE,
+        f"must be within +-{MAX_YAW_PER_METRE:g} rad/m (0.3 degrees a metre is a bent frame, not a calibration)",
+    ),
 )
 
 
 @dataclass(frozen=True)
 class CalibrationValues:
-    """What a calibration file sets: drive changes, and the yaw-rate multiplier (None: not given)."""
+    """What a calibration file sets: drive changes, and odometry's correction (each None: not given)."""
 
     changes: Tuple[Change, ...] = ()
     yaw_rate_multiplier: Optional[float] = None
+    yaw_per_metre: Optional[float] = None
+
+    @property
+    def odometry(self) -> Optional[OdometryCorrection]:
+        """The correction the file sets (what it does not give at its default), None if it sets none."""
+        if self.yaw_rate_multiplier is None and self.yaw_per_metre is None:
+            return None
+        m = 1.0 if self.yaw_rate_multiplier is None else self.yaw_rate_multiplier
+        return OdometryCorrection(m, 0.0 if self.yaw_per_metre is None else self.yaw_per_metre)
 
 
 _KEY_ORDER = {k.name: n for n, k in enumerate(DRIVE_KEYS)}  # the robot file's order of a drive's keys
@@ -66,10 +84,10 @@ def calibration_dict(calibration: Calibration, extra: Sequence[Change] = ()) -> 
 
 
 def changes_dict(
-    changes: Sequence[Change], extra: Sequence[Change] = (), yaw_rate_multiplier: Optional[float] = None
+    changes: Sequence[Change], extra: Sequence[Change] = (), odometry: Optional[OdometryCorrection] = None
 ) -> Dict[str, Any]:
     """(drive index, key, value) changes in the robot file's shape, with extra besides (a key the
-    changes set wins over the same key in extra), and the yaw-rate multiplier if given."""
+    changes set wins over the same key in extra), and odometry's correction if given."""
     # 9 significant digits: far below any uncertainty, and 0.2016 stays 0.2016 in the file
     values = {(index, key): float(f"{value:.9g}") for index, key, value in changes}
     for index, key, value in extra:
@@ -78,8 +96,11 @@ def changes_dict(
     for (index, key), value in sorted(values.items(), key=lambda item: (item[0][0], _KEY_ORDER.get(item[0][1], 0))):
         drives.setdefault(f"drive{index}", {})[key] = value
     out: Dict[str, Any] = {"motor_drives": drives}
-    if yaw_rate_multiplier is not None:
-        out["odometry"] = {"yaw_rate_multiplier": float(f"{yaw_rate_multiplier:.9g}")}
+    if odometry is not None:
+        out["odometry"] = {
+            "yaw_rate_multiplier": float(f"{odometry.yaw_rate_multiplier:.9g}"),
+            "yaw_per_metre": float(f"{odometry.yaw_per_metre:.9g}"),
+        }
     return out
 
 
@@ -87,22 +108,22 @@ def calibration_yaml(
     calibration: Calibration,
     header: str = "",
     extra: Sequence[Change] = (),
-    yaw_rate_multiplier: Optional[float] = None,
+    odometry: Optional[OdometryCorrection] = None,
 ) -> str:
     """The file's text: an optional comment header (each line prefixed with '# '), then the values."""
     changes = [(p.index, p.key, p.value) for p in calibration.estimated]
-    return changes_yaml(changes, header, extra, yaw_rate_multiplier)
+    return changes_yaml(changes, header, extra, odometry)
 
 
 def changes_yaml(
     changes: Sequence[Change],
     header: str = "",
     extra: Sequence[Change] = (),
-    yaw_rate_multiplier: Optional[float] = None,
+    odometry: Optional[OdometryCorrection] = None,
 ) -> str:
     """The file's text for (drive index, key, value) changes: as calibration_yaml."""
     comment = "".join(f"# {line}\n" for line in header.splitlines())
-    data = changes_dict(changes, extra, yaw_rate_multiplier)
+    data = changes_dict(changes, extra, odometry)
     return comment + yaml.safe_dump(data, sort_keys=False, default_flow_style=False)
 
 
@@ -124,10 +145,9 @@ def parse_calibration(data: Any, config: RobotConfig, source: str = "<calibratio
 def parse_calibration_values(data: Any, config: RobotConfig, source: str = "<calibration>") -> CalibrationValues:
     problems: List[Problem] = []
     data = check_top_level(data, TOP_KEYS, problems, source=source, what=WHAT)
-    multiplier = None
+    odometry: Dict[str, Any] = {}
     if data.get("odometry") is not None:
-        values = parse_entry(data["odometry"], "odometry", ODOMETRY_KEYS, problems)
-        multiplier = (values or {}).get("yaw_rate_multiplier")
+        odometry = parse_entry(data["odometry"], "odometry", ODOMETRY_KEYS, problems) or {}
     raw = data.get("motor_drives")
     changes: List[Change] = []
     names = [d.name for d in config.drives]
@@ -162,7 +182,7 @@ def parse_calibration_values(data: Any, config: RobotConfig, source: str = "<cal
             problems += [p for p in e.problems if p not in problems]
     if problems:
         raise ConfigError(source, problems, WHAT)
-    return CalibrationValues(tuple(changes), multiplier)
+    return CalibrationValues(tuple(changes), odometry.get("yaw_rate_multiplier"), odometry.get("yaw_per_metre"))
 
 
 def set_drive_params_command(changes: List[Change], namespace: str = "") -> str:

@@ -26,6 +26,7 @@ from thorvald_model.values import RobotConfig
 
 from ..errors import CalibrationError
 from ..kinematics import DriveState
+from ..kinematics.calculator import NO_CORRECTION, OdometryCorrection
 from ..plugins import load_calculator
 from .recording import DriveRecording, GnssTruth, PoseTruth
 
@@ -56,12 +57,12 @@ def replay(
     recording: DriveRecording,
     calculator_for: Callable = load_calculator,
     *,
-    yaw_rate_multiplier: float = 1.0,
+    correction: OdometryCorrection = NO_CORRECTION,
 ) -> Path:
     """base_driver's odometry of the recorded states with this configuration (and the calibration's
-    yaw-rate multiplier): its pose at each."""
+    odometry correction): its pose at each."""
     calc = calculator_for(config)
-    calc.yaw_rate_multiplier = yaw_rate_multiplier
+    calc.odometry_correction = correction
     poses = np.zeros((len(recording), 3))
     for n, (t, steering, speed) in enumerate(zip(recording.t, recording.steering, recording.speed)):
         pose = calc.calculate_odometry([DriveState(a, v) for a, v in zip(steering, speed)], float(t)).pose
@@ -88,10 +89,10 @@ def odometry_error(
     heading_bias: float = 0.0,
     calculator_for: Callable = load_calculator,
     *,
-    yaw_rate_multiplier: float = 1.0,
+    correction: OdometryCorrection = NO_CORRECTION,
 ) -> OdometryError:
     """The replayed odometry's distance error and end-point difference against ground truth."""
-    t_odo, x_odo, y_odo, yaw_odo = replay(config, recording, calculator_for, yaw_rate_multiplier=yaw_rate_multiplier)
+    t_odo, x_odo, y_odo, yaw_odo = replay(config, recording, calculator_for, correction=correction)
     t, x, y, yaw = truth_path(truth, heading_bias)
     inside = (t >= t_odo[0]) & (t <= t_odo[-1])
     if np.count_nonzero(inside) < 2:

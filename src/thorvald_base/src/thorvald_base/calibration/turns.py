@@ -19,7 +19,7 @@ Pure: numpy, no rospy.
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Tuple, Union
 
 import numpy as np
@@ -27,7 +27,7 @@ import numpy as np
 from thorvald_model.values import RobotConfig
 
 from ..errors import CalibrationError
-from ..kinematics.calculator import YAW_RATE_MULTIPLIER_RANGE
+from ..kinematics.calculator import NO_CORRECTION, YAW_RATE_MULTIPLIER_RANGE, OdometryCorrection
 from ..plugins import load_calculator
 from .odometry_error import replay
 from .recording import DriveRecording, GnssTruth, PoseTruth
@@ -43,7 +43,7 @@ class Turn:
     start: float  # [s] the window compared
     end: float  # [s]
     truth: float  # [rad] ground truth turned, signed
-    odometry: float  # [rad] odometry turned, with the multiplier in effect
+    odometry: float  # [rad] odometry turned, with the correction in effect
 
     @property
     def short_percent(self) -> float:
@@ -54,17 +54,22 @@ class Turn:
 @dataclass(frozen=True)
 class TurnFit:
     turns: Tuple[Turn, ...]
-    in_effect: float  # the multiplier the drive was replayed with
-    gain: float  # truth over odometry, on top of in_effect
+    in_effect: OdometryCorrection  # the correction the drive was replayed with
+    gain: float  # truth over odometry, on top of in_effect's multiplier
     gain_sd: float
 
     @property
     def multiplier(self) -> float:
-        return self.in_effect * self.gain
+        return self.in_effect.yaw_rate_multiplier * self.gain
 
     @property
     def multiplier_sd(self) -> float:
-        return self.in_effect * self.gain_sd
+        return self.in_effect.yaw_rate_multiplier * self.gain_sd
+
+    @property
+    def correction(self) -> OdometryCorrection:
+        """The correction in effect with the fitted multiplier."""
+        return replace(self.in_effect, yaw_rate_multiplier=self.multiplier)
 
 
 def truth_yaw(truth: Union[PoseTruth, GnssTruth], t: np.ndarray) -> np.ndarray:
@@ -92,13 +97,13 @@ def turn_fit(
     config: RobotConfig,
     recording: DriveRecording,
     truth: Union[PoseTruth, GnssTruth],
-    in_effect: float = 1.0,
+    in_effect: OdometryCorrection = NO_CORRECTION,
     calculator_for: Callable = load_calculator,
 ) -> TurnFit:
     """The yaw-rate multiplier that makes the drive's turns read as ground truth turned them.
     CalibrationError if the drive holds fewer than MIN_TURNS turns, or the multiplier comes out
     beyond what slip explains."""
-    t, _, _, yaw = replay(config, recording, calculator_for, yaw_rate_multiplier=in_effect)
+    t, _, _, yaw = replay(config, recording, calculator_for, correction=in_effect)
     lo, hi = (truth.t[0], truth.t[-1]) if isinstance(truth, PoseTruth) else (truth.t_yaw[0], truth.t_yaw[-1])
     inside = (t >= lo) & (t <= hi)
     t, yaw = t[inside], yaw[inside]
@@ -117,7 +122,7 @@ def turn_fit(
     gain = float(a @ b / (b @ b))
     residual = a - gain * b
     sd = float(math.sqrt(residual @ residual / (len(turns) - 1) / (b @ b)))
-    fit = TurnFit(tuple(turns), float(in_effect), gain, sd)
+    fit = TurnFit(tuple(turns), in_effect, gain, sd)
     low, high = YAW_RATE_MULTIPLIER_RANGE
     if not low <= fit.multiplier <= high:
         raise CalibrationError(

@@ -3,7 +3,7 @@
 Pure Python: no rospy, no messages, no pybullet. SI units throughout, base_link frame (REP 103).
 """
 
-from .calculator import BaseCalculator
+from .calculator import BaseCalculator, OdometryCorrection
 from .diff import PltfClc2WDiff
 from .drive import DriveLayer, DriveLayerOutput, SimulatedDrive, SteeringInverter, limit_wheel_speeds
 from .odometry import LeastSquaresEstimator, PaperEstimator, integrate_se2, normalize_angle
@@ -19,6 +19,7 @@ __all__ = [
     "DriveLayerOutput",
     "DriveState",
     "LeastSquaresEstimator",
+    "OdometryCorrection",
     "OdometryResult",
     "PaperEstimator",
     "PltfClc1WD",

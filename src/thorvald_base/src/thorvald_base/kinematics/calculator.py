@@ -11,12 +11,14 @@ Lifecycle, as pluginlib's: construct with no arguments (or options), ``initializ
 passive_wheels)`` once, ``set_params(drives, passive_wheels)`` when parameters change at run time
 (the pose is kept), then ``calculate_command`` and ``calculate_odometry`` every cycle.
 
-``yaw_rate_multiplier`` (1 unless a calibration sets it) multiplies the yaw rate odometry reads from the
-drive states, the translation kept: tyres that slip in turns make the wheels' geometry read a turn a
-little short, as diff_drive_controller's ``wheel_separation_multiplier`` corrects for skid steering.
+``odometry_correction`` (none unless a calibration sets it, :class:`OdometryCorrection`) corrects the
+yaw rate odometry reads from the drive states, the translation kept: tyres that slip in turns make the
+wheels' geometry read a turn a little short (as diff_drive_controller's ``wheel_separation_multiplier``
+corrects for skid steering), and a frame driven straight can read a slow turn it does not make.
 """
 
 import math
+from dataclasses import dataclass
 from typing import List, Optional, Sequence
 
 from thorvald_model.errors import Problem
@@ -30,7 +32,34 @@ from .types import CommandResult, DriveCommand, DriveState, OdometryResult, Pose
 MAX_ODOMETRY_DT = 0.5  # [s]: a longer gap between states is a pause, not motion (the original's rule)
 STOPPED_SPEED = 1e-9  # [m/s]: a wheel this slow has no direction of its own; it keeps its heading
 YAW_RATE_MULTIPLIER_RANGE = (0.9, 1.1)  # a tyre slips a turn short by a few per mille, never 10 %
+MAX_YAW_PER_METRE = 0.005  # [rad/m]: 0.3 degrees a metre is a bent frame or a broken module, not calibration
 REALISABLE_TOLERANCE = 1e-9  # [m/s]: wheel-velocity change below which a twist counts as unchanged
+
+
+@dataclass(frozen=True)
+class OdometryCorrection:
+    """What a calibration adds to the yaw rate the drive states give (``calibrate_odometry --fit turns``
+    and ``--fit straight``): wz' = yaw_rate_multiplier wz + yaw_per_metre vx, the translation kept."""
+
+    yaw_rate_multiplier: float = 1.0
+    yaw_per_metre: float = 0.0  # [rad/m] of travel along base_link's x: a turn read on a straight line, undone
+
+    def problems(self) -> List[str]:
+        out = []
+        low, high = YAW_RATE_MULTIPLIER_RANGE
+        m, b = self.yaw_rate_multiplier, self.yaw_per_metre
+        if isinstance(m, bool) or not (isinstance(m, (int, float)) and low <= m <= high):
+            out.append(f"yaw_rate_multiplier must be in [{low:g}, {high:g}], not {m!r}")
+        if isinstance(b, bool) or not (isinstance(b, (int, float)) and abs(b) <= MAX_YAW_PER_METRE):
+            out.append(f"yaw_per_metre must be within +-{MAX_YAW_PER_METRE:g} rad/m, not {b!r}")
+        return out
+
+    def yaw_rate(self, vx: float, wz: float) -> float:
+        """The corrected yaw rate [rad/s] of a body twist's vx [m/s] and wz [rad/s]."""
+        return self.yaw_rate_multiplier * wz + self.yaw_per_metre * vx
+
+
+NO_CORRECTION = OdometryCorrection()
 
 
 class BaseCalculator:
@@ -57,7 +86,7 @@ class BaseCalculator:
         self._last_steering: List[float] = []
         self._pose = Pose()
         self._last_time: Optional[float] = None
-        self._yaw_rate_multiplier = 1.0
+        self._correction = NO_CORRECTION
 
     # ---- the original's interface ---------------------------------------------------------
     def initialize(self, drives: Sequence, passive_wheels: Sequence = ()) -> None:
@@ -126,7 +155,7 @@ class BaseCalculator:
         steering = [s.steering for s in states]
         speed = [s.speed for s in states]
         vx, vy, wz, res, translating = self._estimator.estimate(steering, speed)
-        wz *= self._yaw_rate_multiplier
+        wz = self._correction.yaw_rate(vx, wz)
         twist = Twist(vx, vy, wz)
         if not all(math.isfinite(v) for v in (vx, vy, wz)):
             return OdometryResult(twist, self._pose, res, dt, False, translating)
@@ -141,7 +170,7 @@ class BaseCalculator:
         nothing: what a calibration compares with ground truth."""
         self._require()
         vx, vy, wz, _, _ = self._estimator.estimate(list(steering), list(speed))
-        return Twist(vx, vy, wz * self._yaw_rate_multiplier)
+        return Twist(vx, vy, self._correction.yaw_rate(vx, wz))
 
     # ---- conveniences ---------------------------------------------------------------------
     @classmethod
@@ -159,17 +188,17 @@ class BaseCalculator:
         self._pose = pose
 
     @property
-    def yaw_rate_multiplier(self) -> float:
-        return self._yaw_rate_multiplier
+    def odometry_correction(self) -> OdometryCorrection:
+        return self._correction
 
-    @yaw_rate_multiplier.setter
-    def yaw_rate_multiplier(self, value: float) -> None:
-        """The factor on odometry's yaw rate, from the next odometry on; KinematicsError unless within
-        YAW_RATE_MULTIPLIER_RANGE (beyond it the robot file's geometry is wrong, not the tyres' grip)."""
-        low, high = YAW_RATE_MULTIPLIER_RANGE
-        if isinstance(value, bool) or not (isinstance(value, (int, float)) and low <= value <= high):
-            raise KinematicsError(f"yaw_rate_multiplier must be in [{low:g}, {high:g}], not {value!r}")
-        self._yaw_rate_multiplier = float(value)
+    @odometry_correction.setter
+    def odometry_correction(self, correction: OdometryCorrection) -> None:
+        """The correction of odometry's yaw rate, from the next odometry on; KinematicsError for values
+        beyond what a calibration explains (the previous correction stays)."""
+        problems = correction.problems()
+        if problems:
+            raise KinematicsError("; ".join(problems))
+        self._correction = correction
 
     def wheel_velocity(self, twist: Twist, index: int):
         """Velocity (vx, vy) [m/s] the twist gives drive index's wheel contact."""
