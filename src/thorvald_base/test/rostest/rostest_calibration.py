@@ -8,6 +8,8 @@ its controller reads; drive2's 0.03 rad to the right.
 * The parameters base_driver publishes (~motor_drives) hold the calibrated values.
 * Commands are rim speeds: at 0.5 m/s drive0's wheel turns at 0.5 / 0.21 = 2.381 rad/s, the others
   at 0.5 / 0.2 = 2.5 rad/s (joint_states), while odometry reads 0.5 m/s.
+* Odometry has the calibration's correction: driven straight at 0.5 m/s it reads 0.002 rad/m x 0.5 m/s
+  of yaw rate, turning at 0.2 rad/s 1.01 x 0.2 rad/s more.
 * Homing drives every steering controller to its own 0, where the wheel truly stands at the offset:
   joint_states (true angles) shows 0.05 rad for steering0 and -0.03 rad for steering2.
 * A calibration file with a steering offset of 0.35 rad (beyond 0.2 rad) makes base_driver refuse to
@@ -73,6 +75,19 @@ class CalibrationTest(unittest.TestCase):
         # the steering stands truly straight, and odometry reads the commanded rim speed
         self.assertTrue(all(abs(joint(msg, f"steering{n}")) < 1e-9 for n in range(len(self.robot))), msg)
         self.assertAlmostEqual(self.odom.wait_for().twist.twist.linear.x, SPEED, places=6)
+
+    def test_odometry_reads_with_the_calibrations_correction(self):
+        self.cmd.send(twist(SPEED))
+        msg = self.odom.wait_for(lambda m: abs(m.twist.twist.linear.x - SPEED) < 1e-6, timeout=WAIT)
+        self.assertIsNotNone(msg, f"odometry/base_raw: {self.odom.latest()}")
+        self.assertAlmostEqual(msg.twist.twist.angular.z, 0.002 * SPEED, places=6)
+        self.cmd.send(twist(SPEED, wz=0.2))
+        expected = 1.01 * 0.2 + 0.002 * SPEED
+        msg = self.odom.wait_for(lambda m: abs(m.twist.twist.angular.z - expected) < 1e-6, timeout=WAIT)
+        self.assertIsNotNone(msg, f"odometry/base_raw: {self.odom.latest()}, {expected} rad/s expected")
+        self.cmd.send(twist(SPEED))  # straight again, as the other tests expect the wheels
+        straight = self.odom.wait_for(lambda m: abs(m.twist.twist.angular.z - 0.002 * SPEED) < 1e-9, timeout=WAIT)
+        self.assertIsNotNone(straight, f"odometry/base_raw: {self.odom.latest()}")
 
     def test_homing_stands_each_wheel_at_its_offset(self):
         self.cmd.send(twist(SPEED))
