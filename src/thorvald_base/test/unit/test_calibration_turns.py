@@ -82,6 +82,9 @@ def test_the_imus_yaw_is_ground_truth_enough_and_a_drive_without_turns_is_refuse
     straight = synthetic_drive(config, STRAIGHT, [d.r_wheel for d in config.drives], [0.0] * 4)
     with pytest.raises(CalibrationError, match=r"holds 0 turns.*drive the turns manoeuvre"):
         turn_fit(config, straight.recording, straight.pose_truth)
+    apart = with_turn_slip(turns_drive(config), left=0.97, right=1.05)  # a multiplier of 1.01 fits neither way
+    with pytest.raises(CalibrationError, match=r"the turns disagree \(the multiplier 1\.01.* no multiplier fits them"):
+        turn_fit(config, apart.recording, apart.pose_truth)
     absurd = with_turn_slip(turns_drive(config), left=1.3, right=1.3)
     with pytest.raises(CalibrationError, match=r"multiplier of 1\.30.*beyond \[0\.9, 1\.1\]"):
         turn_fit(config, absurd.recording, absurd.pose_truth)

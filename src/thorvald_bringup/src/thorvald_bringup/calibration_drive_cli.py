@@ -35,9 +35,9 @@ import contextlib
 import io
 import json
 import os
+import shutil
 import sys
 import textwrap
-from typing import Optional
 
 from thorvald_base.calibration.calibration_file import load_calibration
 from thorvald_base.calibration.torque_balance import relative_errors
@@ -151,8 +151,6 @@ def run(args) -> int:
         if not args.json:
             print(text, end="", flush=True)
         turns = turns_step(args, model, first, out, calibrate_odometry)
-        if turns is None:
-            return 2
         if args.json:
             result = json.loads(text[text.index("{") :])
             result["turns"] = turns
@@ -223,8 +221,6 @@ def run(args) -> int:
     turns = None
     if args.turns:
         turns = turns_step(args, model, scaled, out, calibrate_odometry)
-        if turns is None:
-            return 2
     tyres = None
     if args.as_built:
         tyres = tyre_errors(config, built, load_calibration(first, config), balanced, load_calibration(final, config))
@@ -250,10 +246,11 @@ def run(args) -> int:
     return 0
 
 
-def turns_step(args, model: str, in_effect: str, out: str, calibrate_odometry) -> Optional[dict]:
+def turns_step(args, model: str, in_effect: str, out: str, calibrate_odometry) -> dict:
     """The turns manoeuvre driven with the calibration file in_effect, and odometry's yaw-rate multiplier
     fitted to it over that file into calibration.yaml; --fit turns' JSON with --json (else its text is
-    printed and the dict is empty), or None when the fit failed (its reason printed)."""
+    printed and the dict is empty). When the turns give none (they disagree, or slip beyond reason),
+    calibration.yaml is the file in_effect, the reason is printed and returned as {"error": reason}."""
     bag = os.path.join(out, TURNS_BAG)
     with_fit = argparse.Namespace(**{**vars(args), "calibration": in_effect})
     wall, _ = drive(with_fit, model, bag, "turns", args.side, log="turns")
@@ -262,14 +259,17 @@ def turns_step(args, model: str, in_effect: str, out: str, calibrate_odometry) -
     if not args.json:
         print(f"  drive: {wall:.1f} s wall; bag {bag}", flush=True)
         print("\nodometry's yaw-rate multiplier from U turns of the working radius, all that in effect:", flush=True)
-    captured = io.StringIO()
-    with contextlib.redirect_stdout(captured):
+    captured, said = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(captured), contextlib.redirect_stderr(said):
         status = calibrate_odometry(command)
     text = captured.getvalue()
-    if status != 0 or not args.json:
+    if status != 0:  # the calibration stands without the multiplier
+        shutil.copyfile(in_effect, os.path.join(out, CALIBRATION))
+        reason = said.getvalue().strip().replace("calibrate_odometry: ", "", 1)
+        print(f"no yaw-rate multiplier from the turns ({reason}); {CALIBRATION} is {os.path.basename(in_effect)}")
+        return {"error": reason}
+    if not args.json:
         print(text, end="", flush=True)
-    if status != 0:
-        return None
     return json.loads(text[text.index("{") :]) if args.json else {}
 
 

@@ -36,6 +36,7 @@ TURNING = 0.2  # [rad/s] of odometry's yaw rate: a turn (a field route's U turn:
 MIN_TURN = 1.0  # [s]: a shorter swing is a correction on a straight leg, not a turn
 MARGIN = 1.0  # [s] before and after a turn compared: the whole turn, its transitions included
 MIN_TURNS = 2
+MAX_GAIN_SD = 0.01  # the turns disagree by more: they slip each their own way, and no multiplier fits them
 
 
 @dataclass(frozen=True)
@@ -123,6 +124,13 @@ def turn_fit(
     residual = a - gain * b
     sd = float(math.sqrt(residual @ residual / (len(turns) - 1) / (b @ b)))
     fit = TurnFit(tuple(turns), in_effect, gain, sd)
+    if sd > MAX_GAIN_SD:
+        worst = max(turns, key=lambda turn: abs(turn.short_percent))
+        raise CalibrationError(
+            f"--fit turns: the turns disagree (the multiplier {fit.multiplier:.4f} ± {fit.multiplier_sd:.4f}; the turn "
+            f"at {worst.start:.1f} s read {worst.short_percent:+.1f} % short): they slip each their own way, and no "
+            "multiplier fits them"
+        )
     low, high = YAW_RATE_MULTIPLIER_RANGE
     if not low <= fit.multiplier <= high:
         raise CalibrationError(
@@ -132,4 +140,15 @@ def turn_fit(
     return fit
 
 
-__all__ = ["MARGIN", "MIN_TURN", "MIN_TURNS", "TURNING", "Turn", "TurnFit", "truth_yaw", "turn_fit", "turn_windows"]
+__all__ = [
+    "MARGIN",
+    "MAX_GAIN_SD",
+    "MIN_TURN",
+    "MIN_TURNS",
+    "TURNING",
+    "Turn",
+    "TurnFit",
+    "truth_yaw",
+    "turn_fit",
+    "turn_windows",
+]
