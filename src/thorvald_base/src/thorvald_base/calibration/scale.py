@@ -49,6 +49,7 @@ from ..plugins import load_calculator
 from .estimate import GNSS, MOVING, SIMULATOR, Calibration, ParameterEstimate
 from .odometry_error import as_read_with, replay, truth_path
 from .recording import DriveRecording, GnssTruth, PoseTruth
+from .through_origin import slope_sd, through_origin
 from .turns import truth_yaw
 
 STILL = 0.5  # [s] a standstill shorter than this does not end a leg
@@ -139,10 +140,7 @@ def common_scale(
     truth_m = np.array([leg.truth_m for leg in used])
     odo_m = np.array([leg.odometry_m for leg in used])
     factor = float(np.sum(truth_m) / np.sum(odo_m))
-    sd = math.nan
-    if len(used) > 1:
-        rest = truth_m - factor * odo_m
-        sd = float(math.sqrt(np.sum(rest**2) / (len(used) - 1) / np.sum(odo_m**2)))
+    sd = slope_sd(odo_m, truth_m, factor)
     fit = ScaleFit(factor, sd, tuple(legs), GNSS if isinstance(truth, GnssTruth) else SIMULATOR, in_effect)
     return _with_heading(fit, config, recording, truth, calculator_for) if heading else fit
 
@@ -187,11 +185,7 @@ def _with_heading(fit: ScaleFit, config, recording, truth, calculator_for) -> Sc
         raise CalibrationError(
             "--fit straight: the straight legs do not go along base_link's x, which yaw_per_metre is per metre of"
         )
-    rate = float(forward @ error / (forward @ forward))
-    sd = math.nan
-    if len(used) > 1:
-        rest = error - rate * forward
-        sd = float(math.sqrt(rest @ rest / (len(used) - 1) / (forward @ forward)))
+    rate, sd = through_origin(forward, error)
     total = fit.in_effect.yaw_per_metre + rate
     if abs(total) > MAX_YAW_PER_METRE:
         raise CalibrationError(

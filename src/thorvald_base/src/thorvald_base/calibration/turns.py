@@ -31,6 +31,7 @@ from ..kinematics.calculator import NO_CORRECTION, YAW_RATE_MULTIPLIER_RANGE, Od
 from ..plugins import load_calculator
 from .odometry_error import replay
 from .recording import DriveRecording, GnssTruth, PoseTruth
+from .through_origin import through_origin
 
 TURNING = 0.2  # [rad/s] of odometry's yaw rate: a turn (a field route's U turn: 1.3 rad/s)
 MIN_TURN = 1.0  # [s]: a shorter swing is a correction on a straight leg, not a turn
@@ -120,9 +121,7 @@ def turn_fit(
         )
     a = np.array([turn.truth for turn in turns])
     b = np.array([turn.odometry for turn in turns])
-    gain = float(a @ b / (b @ b))
-    residual = a - gain * b
-    sd = float(math.sqrt(residual @ residual / (len(turns) - 1) / (b @ b)))
+    gain, sd = through_origin(b, a)
     fit = TurnFit(tuple(turns), in_effect, gain, sd)
     if sd > MAX_GAIN_SD:
         worst = max(turns, key=lambda turn: abs(turn.short_percent))
