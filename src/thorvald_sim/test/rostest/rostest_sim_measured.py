@@ -83,14 +83,18 @@ class SimMeasuredTest(unittest.TestCase):
             rospy.Subscriber(f"/tarmac/{topic}", msg_type, lambda m, t=topic: stamps[t].append(m.header.stamp.to_sec()))
             for topic, msg_type in (("drive_currents", DriveCurrents), ("drive_states", BaseState))
         ]
-        # connected before the window opens (a fast simulation outran a fixed wait: a CI run missed two)
+        # The window is the stamps' own, not the test's clock: it opens 0.2 s after the first message of
+        # both topics and is counted once each has delivered one stamped after it. One topic's messages
+        # come in order, so none inside it is still on its way (a window on the test's clock, which
+        # lags a simulator running ahead of real time, counted 158 of 160 drive states twice).
         deadline = time.time() + STARTUP
-        while not all(sub.get_num_connections() for sub in subs):
-            self.assertLess(time.time(), deadline, "no connection to drive_currents and drive_states")
+        while not all(stamps.values()):
+            self.assertLess(time.time(), deadline, "no drive_currents and drive_states")
             time.sleep(0.05)
-        sim_sleep(0.2)
-        start = rospy.get_time()
-        sim_sleep(2.5)
+        start = max(times[0] for times in stamps.values()) + 0.2
+        while not all(times[-1] >= start + 2.1 for times in stamps.values()):
+            self.assertLess(time.time(), deadline, f"no messages stamped after {start + 2.1:.2f} s")
+            time.sleep(0.05)
         for sub in subs:
             sub.unregister()
         for topic, rate in (("drive_currents", 10.0), ("drive_states", 80.0)):
