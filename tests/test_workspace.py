@@ -177,12 +177,13 @@ def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determi
     """calibration_drive, as the main job ran it: the paper's six-wheeled robot as built (field:3)
     through the calibration manoeuvre in the simulator, recorded whole, calibrated from it: the drive
     determines 7 of its 12 combinations, and its own odometry after the calibration is closer to ground
-    truth. Then its wheels balanced from their motor currents: they stop fighting, and each tyre's
-    radius against the others' comes within the issue's 0.3 % of the as-built robot's, where ground
-    truth left it 0.9 % off. Then straight legs at working speed with that in effect give the radii's
-    common factor and odometry's yaw per metre, and the calibration reads their distance and heading right.
-    Last, U turns of the working radius
-    give odometry's yaw-rate multiplier: its tyres slip in a turn, and the turns read short without it."""
+    truth. Then its wheels balanced from their motor currents: they stop fighting, the steering offsets
+    ground truth cannot see (the toe) found from the frame's resistance within a tenth of a degree,
+    where ground truth left them 0.3 deg off, and each tyre's radius comes within half the issue's
+    0.3 % of the as-built robot's, where ground truth left it 0.9 % off. Then straight legs at working
+    speed with that in effect give the radii's common factor and odometry's yaw per metre, and the
+    calibration reads their distance and heading right. Last, U turns of the working radius give
+    odometry's yaw-rate multiplier: its tyres slip in a turn, and the turns read short without it."""
     out = os.path.join(WS, "build", "calibration_drive")
     with open(os.path.join(out, "result.json")) as f:
         text = f.read()
@@ -197,12 +198,16 @@ def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determi
     radii = [v["r_wheel"] for v in result["drives"].values()]
     assert all(0.19 < r < 0.2 for r in radii)  # loaded 1 to 3 % below the configured 0.2 m
     legs = result["balance"]["legs"]
-    assert len(legs) == 8 and all(leg["samples"] >= 3 for leg in legs)
+    assert len(legs) == 8 + 36 + 4 and all(leg["samples"] >= 3 for leg in legs)  # radii, toe, radii again
     assert max(leg["fight_nm"] for leg in legs[-2:]) < 0.5 * legs[0]["fight_nm"]  # the wheels stopped fighting
+    moves = result["balance"]["toe"]["moves"]
+    assert moves[-1]["resistance_nm"][1] < 0.5 * moves[0]["resistance_nm"][1]  # the frame scrubs less
     tyres = result["tyres"]
+    assert tyres["toe"]["ground_truth_deg"] > 0.2 and tyres["toe"]["balanced_deg"] < 0.1
     assert tyres["configured"]["largest_relative_percent"] > 1.0
     assert tyres["ground_truth"]["largest_relative_percent"] > 0.6
-    assert tyres["balanced"]["largest_relative_percent"] < 0.3
+    assert tyres["balanced"]["largest_relative_percent"] < 0.1
+    assert tyres["tyres"]["largest_percent"] < 0.3  # at the straight legs' common factor: 0.19 measured
     straight = result["straight"]
     assert [leg["straight"] for leg in straight["scale"]["legs"]] == [True] * 5
     assert 0.995 < straight["scale"]["factor"] < 1.01 and straight["scale"]["sd"] < 0.001

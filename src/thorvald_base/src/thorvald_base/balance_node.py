@@ -6,14 +6,25 @@ brake it (:mod:`thorvald_base.calibration.torque_balance`). This node drives the
 each) as ``verification_drive`` drives its manoeuvres, and in each pause reads the wheels' torques over
 the leg from their motor currents (``motor_controller_data``, through each drive's motor and gear:
 :mod:`thorvald_model.motors`), and sets the radii for the next leg through base_driver's
-``set_drive_params``: first a probe along the fight, then the fit of every leg so far. At the end it
-prints each leg's fight (the rms of the wheels' torques beyond their mean, and the electrical power
-the motors spent on it) and the balanced radii, and writes them (``~out``): the calibration base_driver
-started with (``~calibration``), each r_wheel replaced by its balanced value. The radii keep their
-geometric mean: the common factor is ground truth's to tell (``calibrate_odometry``).
+``set_drive_params``: first a probe along the fight, then the fit of every leg so far.
 
-Drive it on level, even ground, with the steering offsets calibrated (a wheel homed off rolls at an
-angle, and its sideways scrub shifts the balance by a few tenths of a percent).
+On a robot whose steered wheels have a toe ground truth cannot see (every steered robot of more than
+one steered drive, :mod:`thorvald_base.calibration.toe_balance`), shorter legs follow with the radii
+at that fit: the toe search, which changes one drive's steering offset at a time in the pauses and
+keeps the offsets at which the frame's resistance (the wheels' mean torque against the travel) is
+least; then four legs of the radii again with those offsets (the first at the first legs' fit, the
+next at the radii the first legs' stiffness gives, then at the fit of these legs), whose fit is the
+balance. A wheel homed off scrubs, and the radii at which no wheel fights are then
+off by tenths of a percent.
+
+At the end it prints each leg's fight (the rms of the wheels' torques beyond their mean, and the
+electrical power the motors spent on it), the balanced radii and the offsets found, and writes them
+(``~out``): the calibration base_driver started with (``~calibration``), each r_wheel replaced by its
+balanced value and each searched steering_offset by the one found. The radii keep their geometric
+mean, the offsets the patterns the frame follows (a crab and an arc): those are ground truth's to tell
+(``calibrate_odometry``).
+
+Drive it on level, even ground, with the calibration from the calibration drive in effect.
 
 Parameters: verification_drive's (but ``~manoeuvre``: always ``balance``; ``~side`` [m]: each leg's
 length, default 4), ``~calibration`` (the calibration file base_driver runs with, if any),
@@ -28,7 +39,7 @@ import json
 import math
 import os
 import sys
-from typing import List, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 import rospy
@@ -39,9 +50,10 @@ from thorvald_msgs.msg import ControllerArray, DriveParam
 from thorvald_msgs.srv import DriveParams
 
 from .calibration.calibration_file import CalibrationValues, changes_yaml, read_calibration
-from .calibration.torque_balance import Leg, fight_power, fit_balance, next_radii
+from .calibration.toe_balance import ToeSearch, resistance
+from .calibration.torque_balance import BalanceFit, Leg, fight_power, fit_balance, next_radii
 from .errors import CalibrationError
-from .verification import BALANCE_SPEED, balance_legs
+from .verification import BALANCE_SPEED, BalanceWindow, balance_legs
 from .verification_node import VerificationDrive
 
 DECIDE_AFTER = 1.5  # [s] after a leg's end: its last motor_controller_data has arrived (1 Hz)
@@ -60,11 +72,18 @@ class BalanceDrive(VerificationDrive):
             config = config.with_drive_param(index, key, value)
         self.radii: Tuple[float, ...] = tuple(d.r_wheel for d in config.drives)
         self.start_radii = self.radii
+        self.offsets: Tuple[float, ...] = tuple(d.steering_offset for d in config.drives)
+        self.start_offsets = self.offsets
         self.out = str(rospy.get_param("~out", "") or "")
         self.json = str(rospy.get_param("~json", "") or "")
-        self.windows = balance_legs(self.plan)
-        self.legs: List[Leg] = []
-        self.applied: List[Tuple[float, ...]] = []
+        self.windows: List[BalanceWindow] = balance_legs(self.plan)
+        self.legs: List[Leg] = []  # every leg measured, in order
+        self.first: Optional[BalanceFit] = None  # the radii's first legs' fit, once the toe search starts
+        self.toe: Optional[ToeSearch] = None
+        if any(w.kind == "toe" for w in self.windows):
+            self.toe = ToeSearch(self.config, self.offsets)
+            if self.toe.legs != sum(w.kind == "toe" for w in self.windows):
+                raise RuntimeError("the balance manoeuvre's toe legs are not the toe search's")
         self.samples: List[Tuple[float, Tuple[float, ...]]] = []  # (stamp, propulsion amps per drive)
         self.service = rospy.resolve_name(str(rospy.get_param("~drive_params_service", "base_driver/set_drive_params")))
         rospy.Subscriber(
@@ -87,10 +106,42 @@ class BalanceDrive(VerificationDrive):
         self.samples.append((msg.header.stamp.to_sec(), tuple(amps)))
 
     def during(self, start: float, t: float) -> None:
-        while len(self.legs) < len(self.windows) and t >= self.windows[len(self.legs)][1] + DECIDE_AFTER:
-            self.legs.append(self.measure(start, *self.windows[len(self.legs)]))
+        while len(self.legs) < len(self.windows) and t >= self.windows[len(self.legs)].end + DECIDE_AFTER:
+            window = self.windows[len(self.legs)]
+            self.legs.append(self.measure(start, window.begin, window.end, window.speed))
+            if window.kind == "toe":
+                self.toe.record(resistance(self.legs[-1]))
             if len(self.legs) < len(self.windows):
-                self.apply(next_radii(self.legs))
+                self.next_leg(self.windows[len(self.legs)])
+
+    def radii_legs(self, part: int) -> List[Leg]:
+        """The legs of the radii before the toe search (part 0) or after it (1)."""
+        kinds = [w.kind for w in self.windows[: len(self.legs)]]
+        first_toe = kinds.index("toe") if "toe" in kinds else len(kinds)
+        legs = list(zip(kinds, self.legs))[first_toe:] if part else list(zip(kinds, self.legs))[:first_toe]
+        return [leg for kind, leg in legs if kind == "radii"]
+
+    def next_leg(self, window: BalanceWindow) -> None:
+        """Sets the radii or the steering offsets the next leg is driven with."""
+        if window.kind == "toe":
+            if self.first is None:  # the toe search starts with the radii balanced: the first legs' fit
+                self.first = fit_balance(self.radii_legs(0))
+                self.apply(self.first.radii)
+            self.apply_offsets(self.toe.offsets())
+        elif self.first is None:
+            self.apply(next_radii(self.radii_legs(0)))
+        else:
+            if self.offsets != self.toe.result:
+                self.apply_offsets(self.toe.result)
+            again = self.radii_legs(1)
+            if again:  # the stiffness known from the first legs: every leg after the search gives the radii
+                self.apply(next_radii(again, stiffness_prior=self.first.stiffness))
+
+    def balanced(self) -> BalanceFit:
+        """The fit of the last part's legs of the radii (with the stiffness of the first, after a toe search)."""
+        if self.first is None:
+            return fit_balance(self.radii_legs(0))
+        return fit_balance(self.radii_legs(1), stiffness_prior=self.first.stiffness)
 
     def measure(self, start: float, begin: float, end: float, speed: float) -> Leg:
         """The leg's mean wheel torques over its measured part, from the currents reported in it."""
@@ -110,41 +161,56 @@ class BalanceDrive(VerificationDrive):
         return Leg(self.radii, speed, tuple(float(t) for t in torques), tuple(rates), end - begin, len(rows))
 
     def apply(self, radii: Sequence[float]) -> None:
+        self.set_params("r_wheel", radii, "radii")
+        self.radii = tuple(float(r) for r in radii)
+
+    def apply_offsets(self, offsets: Sequence[float]) -> None:
+        steered = [k for k, d in enumerate(self.config.drives) if d.steerable]
+        self.set_params("steering_offset", [offsets[k] for k in steered], "steering offsets", steered)
+        self.offsets = tuple(float(o) for o in offsets)
+
+    def set_params(self, key: str, values: Sequence[float], what: str, indices: Optional[Sequence[int]] = None) -> None:
+        indices = list(range(len(values))) if indices is None else list(indices)
         try:
             rospy.wait_for_service(self.service, timeout=self.startup_timeout)
-            params = [DriveParam(index=k, type="r_wheel", value=float(r)) for k, r in enumerate(radii)]
+            params = [DriveParam(index=k, type=key, value=float(v)) for k, v in zip(indices, values)]
             answer = rospy.ServiceProxy(self.service, DriveParams)(params)
         except (rospy.ROSException, rospy.ServiceException) as e:
             raise RuntimeError(f"{self.service}: {e}") from None
-        if answer.status < len(radii):
-            raise RuntimeError(f"{self.service} refused the radii: {answer.message}")
-        self.radii = tuple(float(r) for r in radii)
-        self.applied.append(self.radii)
+        if answer.status < len(params):
+            raise RuntimeError(f"{self.service} refused the {what}: {answer.message}")
 
     def balance(self) -> str:
         """Drives the legs; the report, having written ~out."""
         self.run()
         if len(self.legs) < len(self.windows):
             raise RuntimeError(f"the drive ended after {len(self.legs)} of {len(self.windows)} legs")
-        fit = fit_balance(self.legs)
-        text = report(self.name, self.legs, fit, self.start_radii, self.motors, description=self.description)
+        fit = self.balanced()
+        toe = self.toe
+        text = report(self.name, self.legs, fit, self.start_radii, self.motors, description=self.description, toe=toe)
         if self.out:
             changes = [(k, "r_wheel", r) for k, r in enumerate(fit.radii)]
+            if toe is not None:
+                changes += [(k, "steering_offset", toe.result[k]) for k in toe.drives]
             header = (
-                f"balance_wheels: {self.name}, each tyre's radius against the others' from its motor's current;\n"
-                "the other values as the calibration it started with"
+                f"balance_wheels: {self.name}, each tyre's radius against the others' from its motor's current"
+                + (",\nthe steering offsets at which the frame's resistance is least" if toe is not None else "")
+                + ";\nthe other values as the calibration it started with"
             )
             with open(self.out, "w") as f:
                 f.write(changes_yaml(changes, header, self.calibration, self.in_effect.odometry))
             text += f"\nwrote {os.path.abspath(self.out)}"
         if self.json:
             with open(self.json, "w") as f:
-                json.dump(as_json(self.legs, fit, self.start_radii, self.motors), f, indent=2)
+                json.dump(as_json(self.legs, fit, self.start_radii, self.motors, toe=toe), f, indent=2)
         return text
 
 
-def report(name, legs: Sequence[Leg], fit, start: Sequence[float], motors: Sequence[Motor], *, description: str) -> str:
-    """The legs' fight, then each drive's radius before and balanced."""
+def report(
+    name, legs: Sequence[Leg], fit, start: Sequence[float], motors: Sequence[Motor], *, description: str,
+    toe: Optional[ToeSearch] = None,
+) -> str:  # fmt: skip
+    """The legs' fight, each drive's radius before and balanced, and the toe search's offsets."""
     lines = [f"balance_wheels: {name}: {description}", "", "leg  way        fight [N m]  fight [W]"]
     for k, leg in enumerate(legs):
         way = "forwards" if leg.speed > 0 else "back"
@@ -153,6 +219,17 @@ def report(name, legs: Sequence[Leg], fit, start: Sequence[float], motors: Seque
     for k, (before, after, sd) in enumerate(zip(start, fit.radii, fit.sd)):
         change, spread = 100 * (after / before - 1), 100 * sd / after
         lines.append(f"drive{k:<3} {before:>11.5f}   {after:>12.5f}   {change:>+10.3f}   {spread:>6.3f}")
+    if toe is not None:
+        lines += ["", "drive    steering_offset [deg]   found [deg]   change [deg]"]
+        for k in toe.drives:
+            before, after = math.degrees(toe.start[k]), math.degrees(toe.result[k])
+            lines.append(f"drive{k:<3} {before:>21.3f}   {after:>11.3f}   {after - before:>+12.3f}")
+        at = [m.at for m in toe.moves]
+        lines += [
+            "",
+            f"toe search: {toe.legs} legs; the frame's resistance {at[0]:.2f} N m at the start, "
+            f"{min(at):.2f} N m at the least (the wheels' mean torque against the travel)",
+        ]
     first, last = legs[0], legs[-1]
     lines += [
         "",
@@ -163,9 +240,9 @@ def report(name, legs: Sequence[Leg], fit, start: Sequence[float], motors: Seque
     return "\n".join(lines)
 
 
-def as_json(legs: Sequence[Leg], fit, start: Sequence[float], motors: Sequence[Motor]) -> dict:
+def as_json(legs: Sequence[Leg], fit, start: Sequence[float], motors: Sequence[Motor], toe=None) -> dict:
     """The report's figures."""
-    return {
+    out = {
         "legs": [
             {"speed": leg.speed, "fight_nm": leg.fight, "fight_w": max(fight_power(leg, motors), 0.0),
              "torques_nm": list(leg.torques), "samples": leg.samples}
@@ -178,6 +255,20 @@ def as_json(legs: Sequence[Leg], fit, start: Sequence[float], motors: Sequence[M
             for k, (before, after, sd) in enumerate(zip(start, fit.radii, fit.sd))
         },
     }  # fmt: skip
+    if toe is not None:
+        out["toe"] = {
+            "legs": toe.legs,
+            "drives": {
+                f"drive{k}": {"steering_offset_before": toe.start[k], "steering_offset": toe.result[k]}
+                for k in toe.drives
+            },
+            "moves": [
+                {"drive": m.drive, "round": m.round, "step": m.step, "resistance_nm": [m.minus, m.at, m.plus],
+                 "move": m.move}
+                for m in toe.moves
+            ],
+        }  # fmt: skip
+    return out
 
 
 def main():

@@ -264,21 +264,26 @@ def run(args) -> int:
 
 
 def with_balance(calibration: Calibration, observable: Optional[ObservableFit], balanced, robot) -> Calibration:
-    """The calibration with each drive's radius from the balanced calibration file's changes: along the
-    combinations the drive did not determine (with the simulator's ground truth: observable given), or
-    the balanced radii scaled to the calibration's geometric mean (GNSS)."""
+    """The calibration with each drive's radius, and its steering offset where the balance searched
+    the toe, from the balanced calibration file's changes: along the combinations the drive did not
+    determine (with the simulator's ground truth: observable given), or the balanced radii scaled to the
+    calibration's geometric mean and the balance's offsets as they are (GNSS: the toe search kept the
+    crab and arc it started with)."""
     config = robot
     for index, key, value in balanced:
         config = config.with_drive_param(index, key, value)
     radii = [d.r_wheel for d in config.drives]
+    toe = {index for index, key, _ in balanced if key == "steering_offset"}
+    offsets = [d.steering_offset for d in config.drives] if toe else None
     by_name = {f"{p.drive}.{p.key}": p for p in calibration.parameters}
     if observable is not None:
-        values = along_undetermined(observable, [by_name[n].value for n in observable.names], radii)
+        values = along_undetermined(observable, [by_name[n].value for n in observable.names], radii, offsets)
         moved = dict(zip(observable.names, values))
     else:
         fitted = [by_name[f"drive{k}.r_wheel"].value for k in range(len(radii))]
         scale = math.exp(float(np.mean(np.log(fitted)) - np.mean(np.log(radii))))
         moved = {f"drive{k}.r_wheel": r * scale for k, r in enumerate(radii)}
+        moved.update({f"drive{k}.steering_offset": offsets[k] for k in toe if f"drive{k}.steering_offset" in by_name})
     parameters = []
     for p in calibration.parameters:
         value = moved.get(f"{p.drive}.{p.key}", p.value)

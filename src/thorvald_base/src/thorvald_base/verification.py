@@ -16,6 +16,7 @@ from typing import List, Optional, Sequence, Tuple
 from thorvald_model.config import RobotConfig
 from thorvald_model.layout import common_axle
 
+from .calibration.toe_balance import toe_legs
 from .kinematics import Pose, Twist, integrate_se2
 
 SPEED = 1.0  # [m/s] of base_link
@@ -49,7 +50,15 @@ BALANCE_SPEED = 0.2  # [m/s]
 BALANCE_LEGS = 8
 BALANCE_SETTLE = 3.0  # [s] from a leg's start: the robot at speed and the fight steady
 BALANCE_PAUSE = 3.0  # [s]
-BALANCE_LEG = "balance leg"  # the label every leg starts with
+BALANCE_LEG = "balance leg"  # the label every leg of the radii starts with
+# legs of the radii again after the toe search: the first at the first legs' fit, the second a probe (the
+# stiffness known from the first legs, which the scrub softened: about half the one without it), then at
+# the fit of these legs, twice
+BALANCE_AGAIN = 4
+# the toe search's legs (thorvald_base.calibration.toe_balance), on a steered robot between the radii's
+# legs: shorter, each measured after BALANCE_SETTLE, with a pause after it to change the offsets in
+TOE_LEG = "toe leg"
+TOE_LEG_TIME = 6.0  # [s]
 # the straight drive (calibrate_odometry --fit scale): legs along the rolling direction at SPEED, as rows
 # are driven, with standstills between them long enough to average ground truth's position over
 STRAIGHT_PAUSE = 2.0  # [s]
@@ -70,9 +79,14 @@ def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str,
     if not (side > 0.0 and math.isfinite(side)):
         raise ValueError(f"side must be a positive length [m], not {side!r}")
     if name == "balance":
+        toe = toe_legs(config)
+        again = (
+            f", {toe} of {BALANCE_SPEED * TOE_LEG_TIME:g} m the steering offsets changed between them, "
+            f"then {BALANCE_AGAIN} more of {side:g} m"
+        )
         return (
             f"balancing the wheels: {BALANCE_LEGS} straight legs of {side:g} m back and forth at "
-            f"{BALANCE_SPEED:g} m/s, the radii changed between them",
+            f"{BALANCE_SPEED:g} m/s, the radii changed between them" + (again if toe else ""),
             _balance(config, side),
         )
     if name == "turns":
@@ -183,16 +197,28 @@ def _leftwards(axle) -> Tuple[float, float]:
 
 def _balance(config: RobotConfig, side: float) -> List[Segment]:
     """Straight legs of side [m] along the rolling direction, alternately forwards and back, each
-    followed by a pause (balance_wheels changes the radii there): the drive stays on one line of
-    side."""
+    followed by a pause (balance_wheels changes the radii there); on a robot with a toe to search,
+    then that many shorter toe legs back and forth (the steering offsets changed in each pause), and
+    BALANCE_AGAIN legs of the radii again. Each part is an even number of legs, so the drive stays on
+    one line of side."""
     nx, ny = _rolling_direction(config)
     legs = []
-    for k in range(BALANCE_LEGS):
-        sign = 1.0 if k % 2 == 0 else -1.0
+
+    def leg(k: int, length: float, label: str, pause: str) -> None:
+        sign = 1.0 if len(legs) % 4 == 0 else -1.0  # forwards first, then back, and so on (a leg and a pause)
         twist = Twist(sign * BALANCE_SPEED * nx, sign * BALANCE_SPEED * ny, 0.0)
         way = "forwards" if sign > 0 else "back"
-        legs.append(Segment(twist, side / BALANCE_SPEED, f"{BALANCE_LEG} {k + 1}, {side:g} m {way}"))
-        legs.append(Segment(Twist(), BALANCE_PAUSE, "pause: the radii for the next leg"))
+        legs.append(Segment(twist, length / BALANCE_SPEED, f"{label} {k + 1}, {length:g} m {way}"))
+        legs.append(Segment(Twist(), BALANCE_PAUSE, pause))
+
+    for k in range(BALANCE_LEGS):
+        leg(k, side, BALANCE_LEG, "pause: the radii for the next leg")
+    toe = toe_legs(config)
+    if toe:
+        for k in range(toe):
+            leg(k, BALANCE_SPEED * TOE_LEG_TIME, TOE_LEG, "pause: the steering offsets for the next leg")
+        for k in range(BALANCE_AGAIN):
+            leg(BALANCE_LEGS + k, side, BALANCE_LEG, "pause: the radii for the next leg")
     return legs
 
 
@@ -212,14 +238,25 @@ def _straight(config: RobotConfig, side: float) -> List[Segment]:
     return legs
 
 
-def balance_legs(plan: Sequence[Segment]) -> List[Tuple[float, float, float]]:
-    """(start, end [s] from the plan's start, rim speed [m/s] signed) of each balancing leg's measured
-    part: from BALANCE_SETTLE after its start to its end."""
+@dataclass(frozen=True)
+class BalanceWindow:
+    """A balancing leg's measured part: begin and end [s from the plan's start], its rim speed [m/s,
+    negative backwards], and what the leg is for: "radii" or "toe"."""
+
+    begin: float
+    end: float
+    speed: float
+    kind: str
+
+
+def balance_legs(plan: Sequence[Segment]) -> List[BalanceWindow]:
+    """Each balancing leg's measured part, from BALANCE_SETTLE after its start to its end."""
     out, t = [], 0.0
     for seg in plan:
-        if seg.label.startswith(BALANCE_LEG):  # forwards first, then back, and so on
+        kind = "radii" if seg.label.startswith(BALANCE_LEG) else "toe" if seg.label.startswith(TOE_LEG) else ""
+        if kind:  # forwards first, then back, and so on
             speed = math.hypot(seg.twist.vx, seg.twist.vy) * (1.0 if len(out) % 2 == 0 else -1.0)
-            out.append((t + BALANCE_SETTLE, t + seg.duration, speed))
+            out.append(BalanceWindow(t + BALANCE_SETTLE, t + seg.duration, speed, kind))
         t += seg.duration
     return out
 

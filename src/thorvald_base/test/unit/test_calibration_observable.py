@@ -19,7 +19,13 @@ from base_test_helpers import diff, four_ws
 from calibration_test_helpers import DIFF_DRIVE, MIXED, STRAIGHT, synthetic_drive
 
 from thorvald_base.calibration import DriveRecording, as_read_with, odometry_error
-from thorvald_base.calibration.observable import DETERMINED, OFFSET_PRIOR, RADIUS_PRIOR, observable_fit
+from thorvald_base.calibration.observable import (
+    DETERMINED,
+    OFFSET_PRIOR,
+    RADIUS_PRIOR,
+    along_undetermined,
+    observable_fit,
+)
 from thorvald_base.errors import CalibrationError
 from thorvald_base.kinematics import Twist
 
@@ -154,3 +160,34 @@ def test_a_fit_that_moves_parameters_far_beyond_their_priors_says_so():
     slipping = type(t)(t.t, t.x, t.y, t.yaw, 0.8 * t.vx, 0.8 * t.vy, t.wz)
     far = dict(observable_fit(config, drive.recording, slipping).far())
     assert set(RADIUS) <= set(far) and all(far[n] < -10 for n in RADIUS)
+
+
+def test_the_balance_moves_the_fit_only_along_what_the_drive_did_not_determine():
+    """along_undetermined: the fit moved towards the balance's radii and, after a toe search, its steering
+    offsets, along the combinations the drive did not determine: every determined one keeps the fit's
+    value; the frame's diagonals (which no rigid motion shows) take the balance's."""
+    config = four_ws()
+    drive = synthetic_drive(config, MIXED, RADII, OFFSETS)
+    fit = observable_fit(config, drive.recording, drive.pose_truth)
+    values = fit.values
+    unit = np.array([RADIUS_PRIOR if n.endswith("r_wheel") else OFFSET_PRIOR for n in fit.names])
+
+    def in_units(moved):
+        return (
+            np.array([math.log(m / v) if n.endswith("r_wheel") else m - v for n, m, v in zip(fit.names, moved, values)])
+            / unit
+        )
+
+    radii = [0.2 * (1 + 0.004 * s) for s in (1, -1, 1, -1)]  # the diagonal pattern of the radii
+    offsets = [math.radians(0.2) * s for s in (1, -1, 1, -1)]  # and of the offsets
+    for toe in (None, offsets):
+        moved = along_undetermined(fit, values, radii, toe)
+        change = in_units(moved)
+        for c in fit.determined:  # what ground truth saw stays as it saw it
+            assert abs(np.array(c.vector) @ change) < 1e-9
+        assert spans(fit, change, determined=False) == pytest.approx(np.linalg.norm(change), rel=1e-9)
+        assert np.linalg.norm(change) > 0.2  # the diagonals taken from the balance
+    without, with_toe = (in_units(along_undetermined(fit, values, radii, toe)) for toe in (None, offsets))
+    diagonal = vector(fit, DIAGONAL_OFFSETS)
+    assert abs(diagonal @ with_toe) > abs(diagonal @ without) + 0.1  # the offsets' diagonal follows the toe search
+    assert along_undetermined(fit, values, [values[fit.names.index(n)] for n in RADIUS]) == pytest.approx(values)

@@ -10,13 +10,17 @@ from base_test_helpers import EXAMPLE_ROBOTS, diff, four_wd_two_ws, four_ws
 from calibration_test_helpers import synthetic_drive
 
 from thorvald_base.calibration import observable_fit
+from thorvald_base.calibration.toe_balance import toe_legs
 from thorvald_base.kinematics import Pose, Twist, integrate_se2
 from thorvald_base.plugins import load_calculator
 from thorvald_base.verification import (
+    BALANCE_AGAIN,
     BALANCE_LEGS,
+    BALANCE_SETTLE,
     BALANCE_SPEED,
     SPEED,
     STRAIGHT_PAUSE,
+    TOE_LEG_TIME,
     balance_legs,
     commanded_path,
     duration,
@@ -166,10 +170,17 @@ def test_the_balancing_drive_is_straight_legs_both_ways_every_wheel_straight_at_
     assert math.hypot(track[-1].x, track[-1].y) < 1e-6  # back where it started, on one line of the side
     assert max(math.hypot(p.x, p.y) for p in track) <= 3.0 + 1e-6
     windows = balance_legs(plan)
-    assert len(windows) == BALANCE_LEGS
-    assert [math.copysign(1, speed) for _, _, speed in windows] == [1, -1] * (BALANCE_LEGS // 2)
-    for begin, end, speed in windows:
-        assert abs(abs(speed) - BALANCE_SPEED) < 1e-12 and end - begin == pytest.approx(3.0 / BALANCE_SPEED - 3.0)
+    toe = toe_legs(config)  # a robot with a toe to search: its legs, then the radii's again
+    kinds = ["radii"] * BALANCE_LEGS + (["toe"] * toe + ["radii"] * BALANCE_AGAIN if toe else [])
+    assert [w.kind for w in windows] == kinds
+    # a differential robot steers nothing, a one-wheeled one has no toe the frame does not follow
+    assert (toe == 0) == (sum(d.steerable for d in config.drives) < 2)
+    assert [math.copysign(1, w.speed) for w in windows] == [1, -1] * (len(windows) // 2)
+    for w in windows:
+        begin, end, speed = w.begin, w.end, w.speed
+        length = 3.0 if w.kind == "radii" else BALANCE_SPEED * TOE_LEG_TIME
+        assert abs(abs(speed) - BALANCE_SPEED) < 1e-12
+        assert end - begin == pytest.approx(length / BALANCE_SPEED - BALANCE_SETTLE)
         twist = twist_at(plan, (begin + end) / 2)
         result = calc.calculate_command(twist)
         assert not result.changed

@@ -15,7 +15,8 @@ its own master and records what ``calibrate_odometry --ground-truth gnss`` reads
 
 A robot of more than two drives (whose wheels can fight on one rigid frame) goes on, unless
 ``--no-balance``: balance_wheels drives straight legs slowly with that calibration in effect and
-sets each tyre's radius against the others' from the motors' currents (balanced.yaml); the
+sets each tyre's radius against the others' from the motors' currents, and on a steered robot the
+steering offsets ground truth cannot see (the toe) from the frame's resistance (balanced.yaml); the
 calibration drive's fit is taken again with it (``calibrate_odometry --balance``,
 balanced_calibration.yaml); and the straight manoeuvre, driven at working speed with that in effect,
 gives the radii's common factor and odometry's yaw per metre, the turn it reads on a straight line that
@@ -34,12 +35,17 @@ import argparse
 import contextlib
 import io
 import json
+import math
 import os
 import shutil
 import sys
 import textwrap
+from typing import List, Sequence
+
+import numpy as np
 
 from thorvald_base.calibration.calibration_file import load_calibration
+from thorvald_base.calibration.toe_balance import toe_gauge
 from thorvald_base.calibration.torque_balance import relative_errors
 from thorvald_base.verification import SIDE
 from thorvald_model import ConfigError, load_robot_config
@@ -235,13 +241,13 @@ def run(args) -> int:
         print(json.dumps(result, indent=2))
         return 0
     if tyres is not None:
-        names = ("configured", "ground_truth", "balanced", "calibration")
+        names = ("configured", "ground_truth", "tyres", "calibration")
         largest = [tyres[k]["largest_percent"] for k in names]
         relative = [tyres[k]["largest_relative_percent"] for k in names]
         print(
             "each tyre's radius against the as-built robot's, the largest error [%]: configured {:.2f}, from ground "
-            "truth {:.2f}, balanced {:.2f}, the calibration {:.2f} (each against the others only: {:.2f}, {:.2f}, "
-            "{:.2f}, {:.2f})".format(*largest, *relative)
+            "truth {:.2f}, the tyres (balanced, at the straight legs' common factor) {:.2f}, the calibration's "
+            "radii {:.2f} (each against the others only: {:.2f}, {:.2f}, {:.2f}, {:.2f})".format(*largest, *relative)
         )
     return 0
 
@@ -279,10 +285,39 @@ def fights(config) -> bool:
     return len(config.drives) > 2
 
 
+def tyre_radii(balanced: Sequence[float], calibration: Sequence[float]) -> List[float]:
+    """[m] each tyre's rolling radius: the balance's radii (each against the others) at the calibration's
+    geometric mean (the straight legs' common factor)."""
+    factor = math.exp(float(np.mean(np.log(calibration)) - np.mean(np.log(balanced))))
+    return [float(r * factor) for r in balanced]
+
+
+def toe_errors(config, built, odometry_changes, balanced) -> dict:
+    """The steering offsets' largest error off the patterns ground truth sees (the toe) [deg]: from ground
+    truth, and as balance_wheels' toe search found them."""
+    gauge = toe_gauge(config)
+    truth = np.array([d.steering_offset for d in built.drives])
+
+    def toe(offsets) -> float:
+        e = np.asarray(offsets) - truth
+        return float(np.degrees(np.max(np.abs(e - gauge @ (gauge.T @ e)))))
+
+    fitted = config
+    for index, key, value in odometry_changes:
+        fitted = fitted.with_drive_param(index, key, value)
+    start = [d.steering_offset for d in fitted.drives]
+    found = list(start)
+    for name, values in balanced["toe"]["drives"].items():
+        found[int(name[len("drive") :])] = values["steering_offset"]
+    return {"ground_truth_deg": toe(start), "balanced_deg": toe(found)}
+
+
 def tyre_errors(config, built, odometry_changes, balanced, final_changes) -> dict:
     """Each tyre's radius against the as-built robot's [%]: configured, calibrated from ground truth,
-    balanced, and the calibration; absolute and with the common factor removed (what the balance alone
-    can tell)."""
+    balanced (at the common factor of the calibration drive's fit), the tyres (the balance at the
+    calibration's common factor, which the straight legs set: what the drives tell of each tyre), and the
+    calibration (the odometry's radii, which take the tyres' slip on the drive too); absolute and with
+    the common factor removed (what the balance alone can tell)."""
     truth = [d.r_wheel for d in built.drives]
 
     def radii(changes):
@@ -297,7 +332,8 @@ def tyre_errors(config, built, odometry_changes, balanced, final_changes) -> dic
         "balanced": [balanced["drives"][f"drive{k}"]["r_wheel"] for k in range(len(config.drives))],
         "calibration": radii(final_changes),
     }
-    out = {}
+    sets["tyres"] = tyre_radii(sets["balanced"], sets["calibration"])
+    out = {"toe": toe_errors(config, built, odometry_changes, balanced)} if "toe" in balanced else {}
     for name, radii in sets.items():
         errors = [100.0 * (r / t - 1.0) for r, t in zip(radii, truth)]
         relative = 100.0 * relative_errors(radii, truth)

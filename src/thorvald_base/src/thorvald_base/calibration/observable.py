@@ -37,7 +37,7 @@ Pure: numpy, no rospy, no messages.
 
 import math
 from dataclasses import dataclass
-from typing import Callable, List, Sequence, Tuple
+from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -120,18 +120,23 @@ class ObservableFit:
         return out
 
 
-def along_undetermined(fit: ObservableFit, values: Sequence[float], radii: Sequence[float]) -> Tuple[float, ...]:
+def along_undetermined(
+    fit: ObservableFit, values: Sequence[float], radii: Sequence[float], offsets: Optional[Sequence[float]] = None
+) -> Tuple[float, ...]:
     """values (of fit.names, e.g. another fit's) moved towards each drive's radius in radii [m] (what
-    the wheels' torques tell: :mod:`.torque_balance`) along the combinations the drive did not determine
-    only: every determined combination keeps values' (what ground truth saw of the odometry stays as it
-    saw it), the rest takes the radii's, with the offsets they are mixed with. In units of the priors,
-    as the combinations are."""
+    the wheels' torques tell: :mod:`.torque_balance`) and, if given, its steering offset in offsets
+    [rad] (what the frame's resistance tells: :mod:`.toe_balance`) along the combinations the drive did
+    not determine only: every determined combination keeps values' (what ground truth saw of the
+    odometry stays as it saw it), the rest takes the radii's and offsets' (without offsets: with the
+    offsets the radii are mixed with). In units of the priors, as the combinations are."""
     unit = np.array([RADIUS_PRIOR if n.endswith("r_wheel") else OFFSET_PRIOR for n in fit.names])
     delta = np.zeros(len(fit.names))
     for i, name in enumerate(fit.names):
+        k = int(name.split(".")[0][len("drive") :])
         if name.endswith("r_wheel"):
-            k = int(name.split(".")[0][len("drive") :])
             delta[i] = math.log(radii[k] / values[i]) / RADIUS_PRIOR
+        elif offsets is not None:
+            delta[i] = (offsets[k] - values[i]) / OFFSET_PRIOR
     for c in fit.determined:
         v = np.asarray(c.vector)
         delta -= v * float(v @ delta)
