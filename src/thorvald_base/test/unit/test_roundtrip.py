@@ -29,7 +29,7 @@ def calculator(robot_id, estimator):
     return config, calc
 
 
-def assert_twist(got, vx, vy, wz, tol, reach=1.0):
+def assert_twist(got, vx, vy, wz, tol, *, reach=1.0):
     # A wheel slower than STOPPED_SPEED is commanded to stand (it keeps its heading), so a twist that
     # slow reads back up to STOPPED_SPEED off at a wheel: [m/s], and over the nearest wheel's reach
     # [m] from base_link in wz (1.1e-9 rad/s at the standard robot's 0.9 m).
@@ -52,7 +52,7 @@ def test_odometry_recovers_realisable_twist(robot_id, estimator, tol, vx, vy, wz
     odom = calc.calculate_odometry(states, 0.0)
     assert odom.valid
     reach = min(r for r in (math.hypot(d.x, d.y) for d in config.drives) if r > 0)
-    assert_twist(odom.twist, vx, vy, wz, tol, reach)
+    assert_twist(odom.twist, vx, vy, wz, tol, reach=reach)
     if estimator == "lsq":
         # Wheels that agree (noise-free) fit exactly, so the residual is rounding only.
         assert odom.residual < 1e-9 * (1 + abs(vx) + abs(vy) + abs(wz))
