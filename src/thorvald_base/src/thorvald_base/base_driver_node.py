@@ -82,7 +82,7 @@ from . import conversions
 from .bases import create_base_handle, handle_class, handle_class_named, known_handles
 from .bases.handle import DriveTopics, Ports
 from .core import BaseDriverCore, PoseCovariance
-from .diagnostics import LinkWatch, base_statuses
+from .diagnostics import OK, LinkWatch, OdometryWatch, base_statuses
 from .errors import ParameterError, ThorvaldBaseError
 from .lockstep import LockstepCycles, apply_calibration, calibration_said
 from .node_names import Names, Throttle
@@ -186,7 +186,7 @@ class BaseDriverNode:
                 f"~lockstep: true needs a base handle that answers a simulator instant by instant ({lockstep_handles}),"
                 f" not {params.handle}"
             )
-        self.covariance = PoseCovariance(params.twist_covariance)
+        self.covariance = PoseCovariance(params.twist_covariance, len(self.config.drives))
         calculator = load_calculator(self.config, estimator=params.estimator, projection=params.projection)
         handle = create_base_handle(self.config, params, RosPorts(names))
         try:
@@ -259,6 +259,7 @@ class BaseDriverNode:
                 rospy.Service(names.param(f"setRl{relay + 1}"), SetBool, self._relay_service(main.id, relay))
         self._last_status_publish = None
         self.link_watch = LinkWatch()
+        self.odometry_watch = OdometryWatch([d.name for d in self.config.drives])
         for warning in self.config.warnings:
             rospy.logwarn(self.label + ": %s", warning.format(self.config.source))
         rospy.loginfo(
@@ -441,6 +442,9 @@ class BaseDriverNode:
     def publish(self, result, stamp):
         # core.config, not self.config: set_drive_params may have changed r_wheel since start-up
         drives = self.core.config.drives
+        change = self.odometry_watch.change(result.odometry)
+        if change is not None:
+            (rospy.loginfo if change[0] == OK else rospy.logwarn)(self.label + ": %s", change[1])
         channels = [d.channel for d in drives]
         # Each message is built only when somebody reads it (50 a second per topic; in a fleet the
         # building costs more than the driving): nothing is latched, so nobody misses one.
@@ -478,13 +482,14 @@ class BaseDriverNode:
                 self.controller_pub.publish(conversions.controller_array_msg(stamp, controllers))
             if boards:
                 self.io_pub.publish(conversions.io_array_msg(stamp, boards))
-            self.publish_diagnostics(stamp, controllers, batteries, link)
+            self.publish_diagnostics(stamp, controllers, batteries, link, result.odometry)
 
-    def publish_diagnostics(self, stamp, controllers, batteries, link):
-        """/diagnostics: one status per motor controller and battery, one for the bus."""
+    def publish_diagnostics(self, stamp, controllers, batteries, link, odometry):
+        """/diagnostics: one status per motor controller and battery, one for the bus, one for odometry."""
         for change in self.link_watch.changes(link):
             rospy.logwarn(self.label + ": %s", change)
-        statuses = base_statuses(self.names.robot, controllers, batteries, link)
+        names = [d.name for d in self.core.config.drives]
+        statuses = base_statuses(self.names.robot, controllers, batteries, link, odometry=odometry, drive_names=names)
         if statuses:
             msg = DiagnosticArray(
                 status=[
@@ -497,7 +502,7 @@ class BaseDriverNode:
 
     def publish_odometry(self, odometry, stamp):
         if not odometry.valid:
-            self.throttle.warn(self.label + ": odometry calculation failed (non-finite drive states)")
+            self.throttle.warn(self.label + ": odometry calculation failed (a non-finite twist)")
             return
         if self.tf is None and not self.odom_pub.get_num_connections():
             return
@@ -507,7 +512,7 @@ class BaseDriverNode:
             self.base_frame,
             odometry,
             pose_covariance=self.covariance.pose,
-            twist_covariance=self.covariance.twist,
+            twist_covariance=self.covariance.current_twist,
         )
         self.odom_pub.publish(msg)
         if self.tf is not None:

@@ -17,6 +17,7 @@ from thorvald_model.config import RUNTIME_DRIVE_KEYS, RobotConfig
 from .bases import BaseHandle, MeasuredDrive
 from .errors import ParameterError
 from .kinematics import BaseCalculator, DriveCommand, DriveLayer, OdometryResult, Twist
+from .kinematics.calculator import unheard_drives
 
 # A command is absurd, and refused, beyond this multiple of what the fastest wheel can do.
 ABSURD_FACTOR = 10.0
@@ -24,6 +25,12 @@ ABSURD_FACTOR = 10.0
 # The original's twist covariance: 0.001 on the diagonal, 0.03 for the yaw rate (row-major 6 x 6).
 DEFAULT_TWIST_COVARIANCE = tuple((0.03 if i == 5 else 0.001) if i == j else 0.0 for i in range(6) for j in range(6))
 MOVING = 0.005  # [m/s], [rad/s]: faster than this, the pose covariance grows (the original's rule)
+# The stop reason while the drives heard cannot determine the motion (OdometryResult.blind).
+BLIND = "odometry blind"
+# [(m/s)^2], [(rad/s)^2]: the twist's variance while odometry is blind: anything up to about 1 m/s
+# and 1 rad/s, which is what a Thorvald can do.
+BLIND_VARIANCE = 1.0
+BLIND_DIAGONAL = (0, 7, 35)  # vx, vy and wz's places in the row-major 6 x 6 twist covariance
 
 
 @dataclass(frozen=True)
@@ -34,7 +41,7 @@ class CycleResult:
     commands: Tuple[DriveCommand, ...]  # sent to the drives (joint_commands)
     states: Tuple[MeasuredDrive, ...]  # measured after sending (base_state, joint_states)
     odometry: OdometryResult
-    stopped_by: Optional[str]  # "timeout", "safety stop", "homing" or None
+    stopped_by: Optional[str]  # "timeout", "safety stop", "homing", BLIND or None
     twist_changed: bool  # the command was not realisable; the projection's twist was used
     speed_scale: float  # wheel speeds were scaled by this factor to stay within the motors' limits
 
@@ -149,6 +156,11 @@ class BaseDriverCore:
             commands, changed, scale = out.commands, result.changed, out.speed_scale
             if self._safety_stop:
                 stopped_by = "safety stop"
+            elif not self.calculator.determines_motion(unheard_drives([m.as_state() for m in measured])):
+                # Nothing heard can tell how the robot moves: it stops at once, not at the device's
+                # lost timeout (the differential robot's one controller, two seconds of unseen travel).
+                stopped_by = BLIND
+            if stopped_by:
                 commands = self.calculator.set_zero_speed(commands)
         commands = tuple(commands)
         self._last_commands = commands
@@ -168,14 +180,18 @@ class BaseDriverCore:
 
 
 class PoseCovariance:
-    """Covariances of the odometry message: the twist's, fixed, and the pose's, growing while moving.
+    """Covariances of the odometry message: the twist's, and the pose's, growing while moving.
 
-    twist: 36 numbers, row-major 6 x 6 (ParameterError otherwise). The pose covariance starts equal
-    to it and grows by the twist covariance per second of motion (the original added it per cycle,
-    so its growth depended on the loop rate) while any of |vx|, |vy|, |wz| exceeds MOVING.
+    twist: 36 numbers, row-major 6 x 6 (ParameterError otherwise), the covariance of an estimate from
+    every one of the robot's drives (drives of them). From fewer drives (some unheard) it is scaled
+    by drives / heard, as the variance of a mean over fewer wheels; blind (OdometryResult.blind), the
+    linear and yaw rates' variances are BLIND_VARIANCE. ``current_twist`` is the last estimate's.
+    The pose covariance starts equal to twist and grows by the current twist covariance per second
+    of motion (the original added it per cycle, so its growth depended on the loop rate) while any
+    of |vx|, |vy|, |wz| exceeds MOVING, and for every second odometry is blind (the motion is unknown).
     """
 
-    def __init__(self, twist: Sequence[float] = DEFAULT_TWIST_COVARIANCE):
+    def __init__(self, twist: Sequence[float] = DEFAULT_TWIST_COVARIANCE, drives: int = 1):
         if (
             isinstance(twist, (str, bytes))
             or not hasattr(twist, "__len__")
@@ -184,12 +200,24 @@ class PoseCovariance:
         ):
             raise ParameterError(f"~twist_covariance: {twist!r}: must be a list of 36 finite numbers (row-major 6x6)")
         self.twist = tuple(float(v) for v in twist)
+        self.drives = max(1, int(drives))
         self.pose = self.twist
+        self.current_twist = self.twist
+
+    def twist_for(self, odometry: OdometryResult) -> Tuple[float, ...]:
+        """The twist covariance of this estimate (see the class)."""
+        if odometry.blind:
+            return tuple(BLIND_VARIANCE if k in BLIND_DIAGONAL else v for k, v in enumerate(self.twist))
+        heard = self.drives - len(odometry.unheard)
+        if odometry.unheard and heard > 0:
+            return tuple(v * self.drives / heard for v in self.twist)
+        return self.twist
 
     def update(self, odometry: OdometryResult) -> None:
+        self.current_twist = self.twist_for(odometry)
         t = odometry.twist
-        if abs(t.vx) > MOVING or abs(t.vy) > MOVING or abs(t.wz) > MOVING:
-            self.pose = tuple(a + b * odometry.dt for a, b in zip(self.pose, self.twist))
+        if odometry.blind or abs(t.vx) > MOVING or abs(t.vy) > MOVING or abs(t.wz) > MOVING:
+            self.pose = tuple(a + b * odometry.dt for a, b in zip(self.pose, self.current_twist))
 
     def reset(self) -> None:
         self.pose = self.twist
@@ -204,6 +232,8 @@ def _command_limits(config: RobotConfig) -> Tuple[float, float]:
 
 __all__ = [
     "ABSURD_FACTOR",
+    "BLIND",
+    "BLIND_VARIANCE",
     "DEFAULT_TWIST_COVARIANCE",
     "MOVING",
     "RUNTIME_DRIVE_KEYS",

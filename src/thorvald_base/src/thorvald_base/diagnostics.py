@@ -2,14 +2,17 @@
 
 :func:`base_statuses` turns the handle's motor controllers, batteries and link counters into one
 :class:`Status` each (diagnostic_msgs/DiagnosticStatus's fields: level, name, message, hardware id,
-key/values); the node only converts them to messages. :class:`LinkWatch` says what changed in the
-link since the last look (a bus error, lost devices, a wrong script), for the node to log once.
+key/values), and odometry's estimate into one more (from every drive, degraded, blind); the node only
+converts them to messages. :class:`LinkWatch` says what changed in the link since the last look (a bus
+error, lost devices, a wrong script), and :class:`OdometryWatch` what changed in odometry's drives, for
+the node to log once.
 """
 
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from .bases import BatteryInfo, ControllerInfo
+from .kinematics import OdometryResult
 from .modes import BATTERY_LOST, MODE_LOST_CONNECTION
 
 # diagnostic_msgs/DiagnosticStatus levels (a unit test holds them against the message)
@@ -29,13 +32,30 @@ class Status:
     values: Tuple[Tuple[str, str], ...] = ()
 
 
+def odometry_sentence(odometry: OdometryResult, names: Sequence[str]) -> Tuple[int, str]:
+    """(level, message) of what odometry rests on: every drive (OK), the drives heard when some are
+    unheard (WARN: degraded), or too few to tell the motion (ERROR: blind, the wheels stopped)."""
+    if not odometry.unheard:
+        return OK, "from every drive"
+    unheard = ", ".join(names[k] if k < len(names) else str(k) for k in odometry.unheard)
+    heard = len(names) - len(odometry.unheard)
+    if odometry.blind:
+        what = "along the last commanded motion" if heard else "none: zero twist, the pose held"
+        return ERROR, f"blind ({unheard} unheard): the wheels are stopped; the estimate from {heard} drive(s) {what}"
+    return WARN, f"degraded: from {heard} of {len(names)} drives ({unheard} unheard)"
+
+
 def base_statuses(
     namespace: str,
     controllers: Sequence[ControllerInfo],
     batteries: Sequence[BatteryInfo],
     link: Dict[str, str],
+    *,
+    odometry: Optional[OdometryResult] = None,
+    drive_names: Sequence[str] = (),
 ) -> List[Status]:
-    """One status per motor controller and battery, one for the hardware link when there is one.
+    """One status per motor controller and battery, one for the hardware link when there is one, and
+    one for odometry when it is given (what its estimate rests on, odometry_sentence).
 
     A lost controller or battery is an error; a controller's status flag or a battery's alarm is a
     warning; a closed bus, lost devices or a wrong script make the link an error. Names start with
@@ -43,6 +63,11 @@ def base_statuses(
     """
     prefix = f"base_driver ({namespace}): " if namespace else "base_driver: "
     statuses = []
+    if odometry is not None:
+        level, message = odometry_sentence(odometry, drive_names)
+        heard = len(drive_names) - len(odometry.unheard)
+        values = (("drives heard", f"{heard} of {len(drive_names)}"), ("residual", f"{odometry.residual:.4f} m/s"))
+        statuses.append(Status(f"{prefix}odometry", "odometry", level, message, values))
     for c in controllers:
         lost = c.mode == MODE_LOST_CONNECTION
         flags = [name for name, on in c.status_flags if on]
@@ -61,6 +86,27 @@ def base_statuses(
         level = ERROR if failing else OK
         statuses.append(Status(f"{prefix}CAN bus", "can", level, link.get("bus", ""), tuple(link.items())))
     return statuses
+
+
+class OdometryWatch:
+    """The log line a change of what odometry rests on deserves, said once when it changes; nothing
+    before every drive has been heard once (a base starting up hears its drives one by one)."""
+
+    def __init__(self, drive_names: Sequence[str]):
+        self.names = list(drive_names)
+        self._seen: Optional[Tuple[Tuple[int, ...], bool]] = None
+
+    def change(self, odometry: OdometryResult) -> Optional[Tuple[int, str]]:
+        """(level, sentence) when the drives unheard or blindness changed since the last call; else None."""
+        now = (odometry.unheard, odometry.blind)
+        if self._seen is None and odometry.unheard:
+            return None
+        if self._seen is None or now == self._seen:
+            self._seen = now
+            return None
+        self._seen = now
+        level, message = odometry_sentence(odometry, self.names)
+        return level, "odometry " + (message if odometry.unheard else "from every drive again")
 
 
 class LinkWatch:
@@ -83,4 +129,4 @@ class LinkWatch:
         return out
 
 
-__all__ = ["ERROR", "OK", "WARN", "LinkWatch", "Status", "base_statuses"]
+__all__ = ["ERROR", "OK", "WARN", "LinkWatch", "OdometryWatch", "Status", "base_statuses", "odometry_sentence"]

@@ -2,9 +2,10 @@
 """base_driver over SLCAN to the emulated devices of the standard robot (another process).
 
 Commands reach the wheels and come back as measured states; a motor controller silenced mid-drive
-stops every wheel once it has been silent for 2 s and is reported, and control resumes when it is
-heard again; the relay works both ways with an implement on the hub's second port, refuses a frame
-to a base controller's command id, and is muted by the service; the main IO board's relays switch
+stops every wheel once it has been silent for 2 s and is reported, odometry rests on the other
+three drives and says so, and control resumes when it is heard again; the relay works both ways
+with an implement on the hub's second port, refuses a frame to a base controller's command id, and
+is muted by the service; the main IO board's relays switch
 by the original's service names (setRl1, setRl2) without an io section in the robot file; the
 adapter unplugged and plugged back: base_driver survives, reports, and drives again.
 """
@@ -91,8 +92,25 @@ class CanSlcanTest(unittest.TestCase):
             lambda m: any("drive1" in s.name and s.level == DiagnosticStatus.ERROR for s in m.status)
         )
         self.assertIsNotNone(diag, "/diagnostics did not report the lost controller")
+        # Odometry from the three drives heard: the robot stands, and so does odometry (drive1's last
+        # 0.5 m/s, held, would read 0.125 m/s over four drives); its twist covariance says so
+        still = self.odom.wait_for(lambda m: abs(m.twist.twist.linear.x) < 1e-3, timeout=5.0)
+        self.assertIsNotNone(still, "odometry kept moving with drive1 silent and the wheels stopped")
+        later = self.odom.wait_for(lambda m: m.header.stamp.to_sec() > still.header.stamp.to_sec() + 1.0)
+        self.assertAlmostEqual(later.pose.pose.position.x, still.pose.pose.position.x, delta=1e-3)
+        self.assertAlmostEqual(later.twist.covariance[0], 0.001 * 4 / 3, delta=1e-9)
+        degraded = self.diagnostics.wait_for(
+            lambda m: any(
+                s.name.endswith("odometry") and s.level == DiagnosticStatus.WARN and "drive1 unheard" in s.message
+                for s in m.status
+            )
+        )
+        self.assertIsNotNone(degraded, "/diagnostics did not say odometry rests on three drives")
         silence(False)
         self.assertIsNotNone(self.state.wait_for(all_at(SPEED), timeout=10.0), "control did not resume")
+        whole = self.odom.wait_for(lambda m: abs(m.twist.twist.linear.x - SPEED) < 0.01, timeout=5.0)
+        self.assertIsNotNone(whole, "odometry did not follow the drives heard again")
+        self.assertAlmostEqual(whole.twist.covariance[0], 0.001, delta=1e-9)
 
     def test_3_relay_both_ways_guard_and_mute(self):
         implement = can.Bus(interface="slcan", channel=os.path.join(self.links, "port1"), sleep_after_open=0)

@@ -46,8 +46,10 @@ def test_dt_rules_and_zero_pose():
     assert r.pose.x == pytest.approx(0.1 + 0.2)
     calc.zero_odometry_pose()
     assert calc.pose == Pose()
+    # drives whose states hold no number are unheard: with none heard, no motion and no pose change
     bad = calc.calculate_odometry([DriveState(float("nan"), 1.0)] * 4, 5.9)
-    assert not bad.valid and bad.pose == Pose()
+    assert bad.valid and bad.blind and bad.unheard == (0, 1, 2, 3)
+    assert bad.pose == Pose() and bad.twist == Twist()
 
 
 def test_paper_estimator_is_reproducible_with_a_seed_and_detects_translation():

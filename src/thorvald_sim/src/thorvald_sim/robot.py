@@ -38,7 +38,7 @@ import tempfile
 import xml.etree.ElementTree as ET
 from collections import deque
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple, Union
+from typing import List, Optional, Sequence, Set, Tuple, Union
 
 import pybullet as p
 
@@ -63,6 +63,7 @@ FOLLOW_HEADROOM = 2.0  # following states, the steering servo may turn this much
 
 
 GRAVITY = 9.81  # [m/s^2]: a tyre's deflection is rated under its share of the weight at standard gravity
+NO_REPORT = MeasuredDrive(math.nan, math.nan, math.nan, math.nan)  # a silenced drive's encoders
 
 
 @dataclass(frozen=True)
@@ -117,6 +118,7 @@ class SimRobot:
             list(as_built.drives) if as_built else [BuiltDrive(d.wheel_radius, 0.0) for d in description.drives]
         )
         self._history = deque()  # (time, drive states) measured, while reports are delayed
+        self.silenced: Set[int] = set()  # drives whose encoders report nothing (silence)
         self._current_history = deque()  # (time, drive currents) likewise
         self._drive_joints = None  # the joints a drive state reads, in one getJointStates call
         self.client = client
@@ -301,14 +303,26 @@ class SimRobot:
         """What each drive's encoders measure: steering angle and rate, wheel angle and rim speed (the
         configured radius times the wheel's turning rate, as the controller converts it). As built:
         through each drive's homing error and encoder counts, and, with a delay, the newest
-        measurement taken at least that long before now [s] (simulated time)."""
+        measurement taken at least that long before now [s] (simulated time). A silenced drive
+        reports no number (NaN), as drive_states carries it."""
         if self.as_built is None:
-            return self._joint_drive_states()
-        states = [
-            MeasuredDrive(*b.measured(s.steering, s.speed, s.wheel_angle, s.steering_speed))
-            for s, b in zip(self._joint_drive_states(), self.built)
-        ]
-        return self._reported(self._history, now, states)
+            states = self._joint_drive_states()
+        else:
+            states = [
+                MeasuredDrive(*b.measured(s.steering, s.speed, s.wheel_angle, s.steering_speed))
+                for s, b in zip(self._joint_drive_states(), self.built)
+            ]
+            states = self._reported(self._history, now, states)
+        if self.silenced:
+            states = [NO_REPORT if k in self.silenced else s for k, s in enumerate(states)]
+        return states
+
+    def silence(self, drive: int, silent: bool = True) -> None:
+        """Drive index drive's encoders stop reporting (silent) or report again: the fault a CAN
+        controller that went quiet gives base_driver, while its motors still follow commands."""
+        if not 0 <= drive < len(self.description.drives):
+            raise IndexError(f"no drive {drive}: the robot has {len(self.description.drives)}")
+        (self.silenced.add if silent else self.silenced.discard)(drive)
 
     def _reported(self, history: deque, now: Optional[float], measured):
         """As built with a delay: the newest of the measurements kept in history taken at least the delay

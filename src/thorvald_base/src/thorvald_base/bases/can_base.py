@@ -21,6 +21,7 @@ import can
 
 from ..can import protocol as pr
 from ..can.devices import Battery, IoBoard, MotorController
+from ..can.outbox import Outbox, Waiting, write_refused
 from ..errors import ParameterError, ThorvaldBaseError
 from ..kinematics import DriveCommand
 from ..modes import BATTERY_ALARM, BATTERY_LOST, BATTERY_OK, MODE_DRIVE, MODE_HOME, MODE_LOST_CONNECTION, MODE_ONLINE
@@ -32,19 +33,34 @@ UNPUBLISHED_INTERFACES = ("enc_pcb_v1rev6", "enc_pcb_v2rev1")
 RELAY_QUEUE_LIMIT = 100  # frames relayed per cycle; the original dropped its queue past 100
 READ_LIMIT = 2000  # frames read per cycle at most (a flooded bus cannot stall the loop)
 REOPEN_PERIOD = 1.0  # [s] of wall time between attempts to reopen a failed bus
+# [s] of wall time a write may wait for room in a full buffer; what does not fit waits in the outbox
+# for the next poll (half a cycle), so a slow reader never holds base_driver's loop
+WRITE_WAIT = 0.002
+CLOSE_WAIT = 0.1  # [s] closing, for the last frames (the wheels' stop) to fit
 
 
 @dataclass
 class BusCounters:
     """What went wrong on the bus, for /diagnostics."""
 
-    send_errors: int = 0
+    send_errors: int = 0  # writes that failed on a broken bus (it is then shut and reopened)
+    writes_refused: int = 0  # writes a full buffer or a write timeout refused (the bus kept, retried)
     receive_errors: int = 0
     reopened: int = 0
     relay_dropped: int = 0
     relay_refused: int = 0
     unparsable: int = 0  # frames the interface could not parse
     last_error: str = ""
+    last_refused: str = ""  # why the last refused write was refused
+
+
+def _reason(error: BaseException) -> str:
+    """An error and its causes in one line: python-can's message alone hides whether the buffer was full."""
+    parts = []
+    while error is not None and len(parts) < 4:
+        parts.append(f"{type(error).__name__}: {error}")
+        error = error.__cause__ or error.__context__
+    return " <- ".join(parts)
 
 
 def open_bus(interface: str, channel: str, bitrate: int = DEFAULT_BITRATE):
@@ -109,6 +125,12 @@ class CanBase(BaseHandle):
         self.muted = False
         self.allow_relay_to_base = False
         self._pending: List[Tuple[int, bytes]] = [b.command_frame(b.initial) for b in self.ios]
+        self.outbox = Outbox()  # frames a refused write left for the next one
+        self._now: Optional[float] = None  # [s] the last cycle's time: when frames are given and written
+        # a newer command or mode to a controller makes the waiting one worthless; a setup never is
+        self._replaceable = frozenset(
+            n + c.node for c in self.controllers_ for n in (pr.RX_PDO1, pr.RX_PDO3, pr.RX_PDO4)
+        )
 
     @property
     def io_config(self):
@@ -132,11 +154,11 @@ class CanBase(BaseHandle):
         if lost or self.homing:
             commands = [DriveCommand(c.steering, 0.0) for c in commands]
         for controller in self.controllers_:
-            self._send_all(controller.command_frames([commands[k] for k in controller.indices]))
+            self._queue(controller.command_frames([commands[k] for k in controller.indices]))
         if self._pending:
             pending, self._pending = self._pending, []
-            self._send_all(pending)
-        self._send_relayed()
+            self._queue(pending)
+        self._send_relayed()  # and the cycle's frames with them, in one write
 
     def _read_drive_states(self, time) -> List[MeasuredDrive]:
         self._poll(time)
@@ -144,10 +166,12 @@ class CanBase(BaseHandle):
         dt = 0.0 if self._last_read is None else max(0.0, time - self._last_read)
         self._last_read = time
         for controller in self.controllers_:
+            heard = controller.speeds_heard(time)
             for k, (steering, rate, speed) in zip(controller.indices, controller.measured()):
                 radius = self.config.drives[k].r_wheel
-                self.wheel_angles[k] = math.remainder(self.wheel_angles[k] + speed / radius * dt, 2 * math.pi)
-                out[k] = MeasuredDrive(steering, speed, self.wheel_angles[k], rate)
+                if heard:  # the wheel's angle, like odometry, does not turn on a speed nobody reports
+                    self.wheel_angles[k] = math.remainder(self.wheel_angles[k] + speed / radius * dt, 2 * math.pi)
+                out[k] = MeasuredDrive(steering, speed, self.wheel_angles[k], rate, heard)
         return out  # type: ignore[return-value]
 
     def _home_steering(self):
@@ -162,6 +186,11 @@ class CanBase(BaseHandle):
             controller.set_drives(sorted((config.drives[k] for k in controller.indices), key=lambda d: d.channel))
 
     def _close(self):
+        if self.bus is None:
+            return
+        self._flush(CLOSE_WAIT)  # the wheels' stop, if the last write left it waiting
+        if self.bus is None:
+            return
         try:
             self.bus.shutdown()
         except Exception:  # closing a broken bus must not hide why it broke
@@ -239,38 +268,67 @@ class CanBase(BaseHandle):
         return base, device
 
     def _send_relayed(self):
-        frames = list(self.relay_queue)
+        for f in self.relay_queue:  # never replaced: an implement's protocol may count every frame
+            self.outbox.put(Waiting(f.id, f.data, f.is_extended, f.is_remote, self._now))
         self.relay_queue.clear()
-        for f in frames:
-            self._send(f.id, f.data, f.is_extended, f.is_remote)
+        self._flush()
 
     # ---- bus I/O -----------------------------------------------------------------------------
     def _send_all(self, frames: Sequence[Tuple[int, bytes]]) -> None:
-        batch = getattr(self.bus, "send_batch", None)  # one write for all (BufferedSlcanBus)
-        if batch is None or len(frames) < 2:
-            for can_id, data in frames:
-                self._send(can_id, data)
-            return
-        try:
-            batch([can.Message(arbitration_id=i, data=d, is_extended_id=False) for i, d in frames], timeout=0.05)
-        except Exception as e:  # bus-off, a full buffer, a port that went away
-            self._bus_error("send", e)
+        self._queue(frames)
+        self._flush()
 
     def _send(self, can_id: int, data: bytes, extended: bool = False, remote: bool = False) -> None:
-        if self.bus is None and not self._try_reopen():
-            self.counters.send_errors += 1
+        self.outbox.put(Waiting(can_id, data, extended, remote, self._now))
+        self._flush()
+
+    def _queue(self, frames: Sequence[Tuple[int, bytes]]) -> None:
+        for can_id, data in frames:
+            key = can_id if can_id in self._replaceable else None
+            self.outbox.put(Waiting(can_id, data, since=self._now), key)
+
+    def _flush(self, wait: float = WRITE_WAIT) -> None:
+        """Writes the waiting frames: a refused write keeps them for the next one, a broken bus is reopened."""
+        if not len(self.outbox):
             return
-        try:
-            self.bus.send(
-                can.Message(arbitration_id=can_id, data=data, is_extended_id=extended, is_remote_frame=remote),
-                timeout=0.01,
-            )
-        except Exception as e:  # bus-off, a full buffer, a port that went away
-            self._bus_error("send", e)
+        waiting = self.outbox.waiting(self._now)  # the frames that waited too long dropped, bus or none
+        if not waiting or (self.bus is None and not self._try_reopen()):
+            return
+        messages = [
+            can.Message(arbitration_id=f.can_id, data=f.data, is_extended_id=f.extended, is_remote_frame=f.remote)
+            for f in waiting
+        ]
+        sent, error = self._write(messages, wait)
+        self.outbox.sent(sent, self._now)
+        if error is not None and not write_refused(error):
+            self._bus_error("send", error)
+        elif sent < len(messages):
+            self.counters.writes_refused += 1
+            self.counters.last_refused = "the buffer is full" if error is None else _reason(error)
+
+    def _write(self, messages: List[can.Message], wait: float) -> Tuple[int, Optional[Exception]]:
+        """(how many of the messages went, in order; the error that stopped the rest, if any)."""
+        batch = getattr(self.bus, "send_batch", None)  # one write for all (BufferedSlcanBus)
+        if batch is not None:
+            try:
+                return batch(messages, timeout=wait), None
+            except Exception as e:  # the interface's own errors, whatever their class
+                return 0, e
+        for k, msg in enumerate(messages):
+            try:
+                self.bus.send(msg, timeout=wait)
+            except Exception as e:  # a full buffer, bus-off, a port that went away
+                return k, e
+        return len(messages), None
 
     def _poll(self, time: float) -> None:
+        self._now = time
         if self.bus is None and not self._try_reopen():
             return
+        if len(self.outbox):  # what a refused write left: retried at every poll, twice a cycle
+            self._flush()
+            if self.bus is None:
+                return
         for _ in range(READ_LIMIT):
             try:
                 msg = self.bus.recv(timeout=0.0)
@@ -369,6 +427,12 @@ class CanBase(BaseHandle):
         values = {
             "bus": "open" if self.bus is not None else "closed (reopening)",
             "send errors": str(c.send_errors),
+            "writes refused": str(c.writes_refused),
+            "frames queued": str(self.outbox.counters.deferred),
+            "frames waiting": str(len(self.outbox)),
+            "commands superseded": str(self.outbox.counters.superseded),
+            "frames dropped": str(self.outbox.counters.dropped),
+            "worst write latency": f"{self.outbox.counters.worst_latency:.3f} s",
             "receive errors": str(c.receive_errors),
             "bus reopened": str(c.reopened),
             "malformed frames": str(self.malformed_frames + c.unparsable),
@@ -378,6 +442,8 @@ class CanBase(BaseHandle):
         }
         if c.last_error:
             values["last error"] = c.last_error
+        if c.last_refused:
+            values["last write refused"] = c.last_refused
         if self.stopped_for_lost:
             values["wheels stopped: lost"] = ", ".join(self.stopped_for_lost)
         mismatches = [c.script_mismatch for c in self.controllers_ if c.script_mismatch]

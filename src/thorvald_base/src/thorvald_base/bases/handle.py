@@ -19,15 +19,20 @@ from ..kinematics import DriveCommand, DriveState
 
 @dataclass(frozen=True)
 class MeasuredDrive:
-    """A drive's measured state with the rates a BaseState carries."""
+    """A drive's measured state with the rates a BaseState carries.
+
+    heard: False when the drive's reports stopped (older than the handle's report timeout, or none
+    came); the values are then the last ones heard, which odometry must not integrate.
+    """
 
     steering: float  # [rad]
     speed: float  # wheel rim speed [m/s]
     wheel_angle: float  # [rad]
     steering_speed: float  # [rad/s]
+    heard: bool = True
 
     def as_state(self) -> DriveState:
-        return DriveState(self.steering, self.speed, self.wheel_angle)
+        return DriveState(self.steering, self.speed, self.wheel_angle, self.heard)
 
 
 @dataclass(frozen=True)
@@ -128,7 +133,8 @@ class BaseHandle:
     Contract, for every handle:
 
     * ``send_drive_commands`` once per cycle, one command per drive after the drive layer;
-      ``read_drive_states`` the latest measured state of every drive, in drive order.
+      ``read_drive_states`` the latest measured state of every drive, in drive order, each marked
+      unheard (``MeasuredDrive.heard``) when its reports stopped: a held value is no measurement.
     * ``home_steering`` starts homing; ``homing`` is true until the handle ends it (the homing is
       done) or base_driver calls ``end_homing`` because a new velocity command arrived. What the
       drives do meanwhile is the handle's business.

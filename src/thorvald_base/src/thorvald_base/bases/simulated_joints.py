@@ -24,8 +24,11 @@ steps on as soon as the cycle's commands reach it, and the next instant's states
 the cycle still reads (base_driver reads once more after sending): they belong to the next cycle.
 
 Homing points every wheel straight with zero speed until base_driver ends it. Measurements older
-than ``stale_after`` [s] mean the simulator lost the robot: the wheels are sent zero speeds and the
-controllers read as lost.
+than ``stale_after`` [s] mean the simulator lost the robot: the wheels are sent zero speeds, the
+controllers read as lost and every drive as unheard. A drive whose measurement holds no number (NaN:
+the simulator's silenced drive, an encoder that gave no reading) is unheard at once and keeps the
+values last heard; unheard for longer than ``stale_after`` it is lost, as a CAN controller that went
+quiet is: every wheel is sent zero speed and its controller reads as lost until it is heard again.
 
 Rim speeds cross the topics as the simulator converts them: with the radius of the robot it spawned,
 the configuration's ``r_wheel`` when this handle was made (the spawn radius). When set_drive_params
@@ -34,10 +37,11 @@ CAN controller's would: a rim speed v is sent as v * r_spawn / r_now (the joint 
 and a measured one read as v * r_now / r_spawn. Angles (steering, wheel) and currents cross unchanged.
 """
 
+import math
 import threading
 from collections import deque
 from dataclasses import replace
-from typing import Callable, Optional, Sequence, Tuple
+from typing import Callable, List, Optional, Sequence, Tuple
 
 from thorvald_model.motors import Motor, output_torque, propulsion_motor, steering_motor
 
@@ -62,8 +66,9 @@ class SimulatedJointsBase(BaseHandle):
         self._send = send
         self.stale_after = stale_after
         self._lock = threading.Lock()
-        self._unmeasured = [MeasuredDrive(0.0, 0.0, 0.0, 0.0) for _ in config.drives]  # read before any came
+        self._unmeasured = [MeasuredDrive(0.0, 0.0, 0.0, 0.0, heard=False) for _ in config.drives]  # before any came
         self._history = deque(maxlen=HISTORY)  # (time, states) of the last measurements, oldest first
+        self._heard_at: List[Optional[float]] = [None] * len(config.drives)  # [s] each drive's last reading
         self._currents = deque(maxlen=HISTORY)  # (time, (prop amps, steer amps)) likewise
         self._topics = None
         self._arrived = threading.Condition(self._lock)  # lockstep: new drive states
@@ -94,7 +99,11 @@ class SimulatedJointsBase(BaseHandle):
         with self._lock:
             if self._history and time < self._history[-1][0]:
                 self._history.clear()  # simulated time went back (a reset)
-            self._history.append((time, list(states)))
+                self._heard_at = [None] * len(self._heard_at)
+            last = self._history[-1][1] if self._history else self._unmeasured
+            states = [s if _a_reading(s) else replace(held, heard=False) for s, held in zip(states, last)]
+            self._heard_at = [time if s.heard else t for s, t in zip(states, self._heard_at)]
+            self._history.append((time, states))
             self._arrived.notify_all()
 
     def update_currents(self, prop_amps: Sequence[float], steer_amps: Sequence[float], time: float) -> None:
@@ -139,6 +148,11 @@ class SimulatedJointsBase(BaseHandle):
         if self._send is not None and self._last_sent is not None:
             self._send(self._last_sent, time)
 
+    def lost_drives(self, time: float) -> List[int]:
+        """The drives (indices) not heard for longer than stale_after [s] at time [s], or never."""
+        with self._lock:
+            return [k for k, t in enumerate(self._heard_at) if t is None or time - t > self.stale_after]
+
     def online(self, time: float) -> bool:
         with self._lock:
             return self._measured_time is not None and time - self._measured_time <= self.stale_after
@@ -146,7 +160,7 @@ class SimulatedJointsBase(BaseHandle):
     def _send_drive_commands(self, commands, time):
         if self.homing:
             commands = tuple(DriveCommand(0.0, 0.0) for _ in commands)
-        elif not self.online(time):
+        elif self.lost_drives(time):
             commands = tuple(DriveCommand(c.steering, 0.0) for c in commands)
         if self._send is not None:
             self._last_sent = tuple(DriveCommand(c.steering, c.speed / k) for c, k in zip(commands, self._scales))
@@ -155,6 +169,8 @@ class SimulatedJointsBase(BaseHandle):
     def _read_drive_states(self, time):
         with self._lock:
             measured = list(self._at(self._history, time, self._unmeasured))
+        if not self.online(time):
+            measured = [replace(m, heard=False) for m in measured]
         return [replace(m, speed=m.speed * k) if k != 1.0 else m for m, k in zip(measured, self._scales)]
 
     def _home_steering(self):
@@ -167,7 +183,7 @@ class SimulatedJointsBase(BaseHandle):
     def controllers(self, time):
         # One controller per type-0 drive (propulsion + steering channels) and one per pair of type-1
         # drives (two propulsion channels), as on the robot; channels in the drives' order.
-        mode = MODE_ONLINE if self.online(time) else MODE_LOST_CONNECTION
+        lost = set(self.lost_drives(time))
         drives = self.config.drives
         states = self._read_drive_states(time)  # the controllers' own angles: no steering offset
         with self._lock:  # None: no currents came yet
@@ -189,7 +205,7 @@ class SimulatedJointsBase(BaseHandle):
                     type="simulated joints",
                     version="thorvald_sim",
                     can_id=c.node,
-                    mode=mode,
+                    mode=MODE_LOST_CONNECTION if lost.intersection(c.indices) else MODE_ONLINE,
                     motor_vars=tuple(motor_vars),
                 )
             )
@@ -198,6 +214,10 @@ class SimulatedJointsBase(BaseHandle):
     def _close(self):
         if self._topics is not None:
             self._topics.close()
+
+
+def _a_reading(state: MeasuredDrive) -> bool:
+    return all(math.isfinite(v) for v in (state.steering, state.speed, state.wheel_angle, state.steering_speed))
 
 
 def _channel(amps: Optional[float], motor: Motor, rate: float, limit: float) -> Tuple[float, float]:

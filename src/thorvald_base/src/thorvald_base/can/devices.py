@@ -12,6 +12,10 @@ from ..modes import MODE_PRE_INITIATION
 from . import protocol as pr
 
 LOST_AFTER = 2.0  # [s] without a frame from a device
+# A motor controller's speeds (TxPDO1) older than REPORT_PERIODS of its own report period, and at
+# least MIN_REPORT_TIMEOUT, are unheard: odometry leaves them out long before the device is lost.
+REPORT_PERIODS = 5
+MIN_REPORT_TIMEOUT = 0.2  # [s]: a busy machine delays a 50 Hz report by a cycle or two, not by 10
 
 
 class Device:
@@ -60,6 +64,8 @@ class MotorController(Device):
         self.script: Optional[pr.TxPdo4] = None
         self.encoders: Optional[pr.TxPdo4] = None
         self.mode = MODE_PRE_INITIATION  # RxPDO3 takes the BaseState modes
+        self.tx1_time: Optional[float] = None  # [s] when its speeds last came
+        self.report_period: Optional[float] = None  # [s] between its speeds, a running mean
 
     def set_drives(self, drives: Sequence) -> None:
         self.drives = list(drives)
@@ -90,6 +96,7 @@ class MotorController(Device):
         function = can_id - self.node
         if function == pr.TX_PDO1:
             self.tx1 = pr.decode_tx_pdo1(data) if self.steered else pr.decode_tx_pdo1_diff(data)
+            self._speeds_came(self.last_heard)
         elif function == pr.TX_PDO2:
             self.tx2 = pr.decode_tx_pdo2(data)
         elif function == pr.TX_PDO3:
@@ -103,6 +110,20 @@ class MotorController(Device):
             else:
                 self.encoders = m
         # heartbeat, SDO and the frames to the controller (seen on a shared bus) only refresh it
+
+    def _speeds_came(self, time: float) -> None:
+        if self.tx1_time is not None and 0.0 < time - self.tx1_time <= LOST_AFTER:
+            # frames read in one cycle share its time: only the cycles' gaps count
+            interval = time - self.tx1_time
+            self.report_period = interval if self.report_period is None else 0.9 * self.report_period + 0.1 * interval
+        self.tx1_time = time
+
+    def speeds_heard(self, time: float) -> bool:
+        """Whether its speeds and steering (TxPDO1) are recent enough to measure the motion at time [s]."""
+        if self.tx1_time is None:
+            return False
+        timeout = max(MIN_REPORT_TIMEOUT, REPORT_PERIODS * (self.report_period or 0.0))
+        return time - self.tx1_time <= timeout
 
     def measured(self) -> List[Tuple[float, float, float]]:
         """(steering [rad], steering rate [rad/s], wheel rim speed [m/s]) per drive, channel order."""

@@ -19,14 +19,14 @@ corrects for skid steering), and a frame driven straight can read a slow turn it
 
 import math
 from dataclasses import dataclass
-from typing import List, Optional, Sequence
+from typing import Dict, List, Optional, Sequence, Tuple
 
 from thorvald_model.errors import Problem
 from thorvald_model.layout import AxleLine, common_axle
 
 from ..errors import KinematicsError
 from .geometry import DEFAULT_PROJECTION, Layout, check_projection
-from .odometry import DEFAULT_ESTIMATOR, ESTIMATORS, integrate_se2, make_estimator
+from .odometry import DEFAULT_ESTIMATOR, ESTIMATORS, integrate_se2, make_estimator, wheel_velocities
 from .types import CommandResult, DriveCommand, DriveState, OdometryResult, Pose, Twist
 
 MAX_ODOMETRY_DT = 0.5  # [s]: a longer gap between states is a pause, not motion (the original's rule)
@@ -62,6 +62,13 @@ class OdometryCorrection:
 NO_CORRECTION = OdometryCorrection()
 
 
+def unheard_drives(states: Sequence[DriveState]) -> Tuple[int, ...]:
+    """The drives (indices) odometry must leave out: their reports stopped, or hold no number."""
+    return tuple(
+        k for k, s in enumerate(states) if not (s.heard and math.isfinite(s.steering) and math.isfinite(s.speed))
+    )
+
+
 class BaseCalculator:
     """Base class of every kinematics calculator plugin.
 
@@ -87,6 +94,8 @@ class BaseCalculator:
         self._pose = Pose()
         self._last_time: Optional[float] = None
         self._correction = NO_CORRECTION
+        self._partial: Dict[Tuple[int, ...], Optional[tuple]] = {}  # unheard drives -> lsq_for, or None
+        self._last_motion = Twist()  # the last twist commanded that moves the robot
 
     # ---- the original's interface ---------------------------------------------------------
     def initialize(self, drives: Sequence, passive_wheels: Sequence = ()) -> None:
@@ -109,6 +118,7 @@ class BaseCalculator:
         keep = self.layout is not None and len(self.layout.drives) == len(drives)
         self.layout = layout
         self._estimator = make_estimator(self.estimator_name, layout, self.seed)
+        self._partial = {}
         if not keep:
             self._last_steering = [0.0] * len(drives)
 
@@ -133,6 +143,8 @@ class BaseCalculator:
                 realised = Twist(*vals)
         commands = self._commands(realised)
         self._last_steering = [c.steering for c in commands]
+        if any(abs(v) > STOPPED_SPEED for v in (realised.vx, realised.vy, realised.wz)):
+            self._last_motion = realised
         return CommandResult(tuple(commands), realised if changed else twist, twist, changed)
 
     def set_zero_speed(self, commands: Sequence[DriveCommand]) -> List[DriveCommand]:
@@ -154,13 +166,58 @@ class BaseCalculator:
         self._last_time = time
         steering = [s.steering for s in states]
         speed = [s.speed for s in states]
-        vx, vy, wz, res, translating = self._estimator.estimate(steering, speed)
+        unheard = unheard_drives(states)
+        blind = False
+        if not unheard:
+            vx, vy, wz, res, translating = self._estimator.estimate(steering, speed)
+        else:
+            vx, vy, wz, res, blind = self._estimate_heard(unheard, steering, speed)
+            translating = None
         wz = self._correction.yaw_rate(vx, wz)
         twist = Twist(vx, vy, wz)
         if not all(math.isfinite(v) for v in (vx, vy, wz)):
-            return OdometryResult(twist, self._pose, res, dt, False, translating)
+            return OdometryResult(twist, self._pose, res, dt, False, translating, unheard, blind)
         self._pose = integrate_se2(self._pose, twist, dt)
-        return OdometryResult(twist, self._pose, res, dt, True, translating)
+        return OdometryResult(twist, self._pose, res, dt, True, translating, unheard, blind)
+
+    def determines_motion(self, unheard: Sequence[int]) -> bool:
+        """Whether the drives heard (every drive but those indices) determine the robot's motion by
+        themselves: two steered drives do, one with a fixed axle does, one wheel of a differential
+        robot does not."""
+        return not unheard or self._heard_lsq(tuple(unheard)) is not None
+
+    def _heard_lsq(self, unheard: Tuple[int, ...]):
+        if unheard not in self._partial:
+            layout = self._require()
+            self._partial[unheard] = layout.lsq_for([k not in unheard for k in range(len(layout.drives))])
+        return self._partial[unheard]
+
+    def _estimate_heard(self, unheard: Tuple[int, ...], steering: Sequence[float], speed: Sequence[float]):
+        """(vx, vy, wz, residual, blind) from the drives heard alone, whichever estimator: the least-squares
+        fit over them where they determine the motion; else (blind) the motion last commanded, scaled to
+        what they measure (both wheels of a differential robot follow one command, so its shape holds
+        while the base stops), or none with no drive heard or no motion commanded yet."""
+        layout = self.layout
+        heard = [k for k in range(len(layout.drives)) if k not in unheard]
+        xs, ys = [layout.x[k] for k in heard], [layout.y[k] for k in heard]
+        wvx, wvy = wheel_velocities([steering[k] for k in heard], [speed[k] for k in heard])
+        p = self._heard_lsq(unheard)
+        if p is not None:
+            b = (sum(wvx), sum(wvy), sum(x * my - y * mx for x, y, mx, my in zip(xs, ys, wvx, wvy)))
+            vx, vy, wz = (sum(p[i][j] * b[j] for j in range(3)) for i in range(3))
+            blind = False
+        else:
+            shape, blind = self._last_motion, True
+            num = den = 0.0
+            for x, y, mx, my in zip(xs, ys, wvx, wvy):
+                ux, uy = shape.vx - shape.wz * y, shape.vy + shape.wz * x
+                num += ux * mx + uy * my
+                den += ux * ux + uy * uy
+            scale = num / den if den > STOPPED_SPEED * STOPPED_SPEED else 0.0
+            vx, vy, wz = shape.vx * scale, shape.vy * scale, shape.wz * scale
+        errors = [(vx - wz * y - mx) ** 2 + (vy + wz * x - my) ** 2 for x, y, mx, my in zip(xs, ys, wvx, wvy)]
+        res = math.sqrt(sum(errors) / len(errors)) if errors else 0.0
+        return vx, vy, wz, res, blind
 
     def zero_odometry_pose(self) -> None:
         self._pose = Pose()

@@ -21,7 +21,7 @@ A twist that breaks the constraint is replaced by a realisable one (the projecti
 """
 
 import math
-from typing import List, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 from thorvald_model.layout import axle_lines, common_axle
 
@@ -132,15 +132,24 @@ class Layout:
         self.lsq_projection = matmul(matmul(matmul(bt, reduced), self.basis), m_all)
         # Least-squares odometry: minimise sum |J_i t - v_i|^2 over the measured drives, subject to
         # the constraints, so t = P b with b = sum J_i^T v_i.
-        m_drives = wheel_matrix(list(zip(self.x, self.y)))
-        try:
-            reduced = inverse(matmul(matmul(self.basis, m_drives), bt))
-        except KinematicsError:
+        self.lsq = self.lsq_for(tuple(True for _ in self.drives))
+        if self.lsq is None:
             raise KinematicsError(
                 "the drives' wheel velocities cannot determine the robot's motion (one drive needs fixed "
                 "passive wheels off its position)"
-            ) from None
-        self.lsq = matmul(matmul(bt, reduced), self.basis)
+            )
+
+    def lsq_for(self, heard: Sequence[bool]) -> Optional[Matrix]:
+        """P of the least-squares odometry over the drives heard (t = P b, b summed over them), None if
+        they cannot determine the motion. The constraints stay every wheel's: a type-1 drive whose
+        reports stopped still cannot slide sideways."""
+        bt = transpose(self.basis)
+        m_heard = wheel_matrix([(x, y) for x, y, h in zip(self.x, self.y, heard) if h])
+        try:
+            reduced = inverse(matmul(matmul(self.basis, m_heard), bt))
+        except KinematicsError:
+            return None
+        return tuple(tuple(row) for row in matmul(matmul(bt, reduced), self.basis))
 
     @property
     def constrained(self) -> bool:

@@ -43,12 +43,14 @@ class DriveState:
     """What one drive measures (or the simulated drive reports).
 
     steering: steering angle [rad]; speed: wheel rim speed [m/s]; wheel_angle: integrated wheel
-    rotation [rad] (joint position of the wheel, not used by odometry).
+    rotation [rad] (joint position of the wheel, not used by odometry); heard: False when the drive's
+    reports stopped (its values are the last ones heard, or none): odometry leaves it out.
     """
 
     steering: float
     speed: float
     wheel_angle: float = 0.0
+    heard: bool = True
 
 
 @dataclass(frozen=True)
@@ -73,7 +75,12 @@ class OdometryResult:
     twist: estimated body velocity; pose: pose after integrating over dt [s]; residual: RMS over
     the drives of the difference between each measured wheel velocity vector and the one the
     estimated twist implies [m/s] (0 for wheels that agree; grows with slip and disagreement);
-    valid: False when the states held NaN, in which case the pose was not changed.
+    valid: False when the calculator gave a non-finite twist, in which case the pose was not changed.
+
+    unheard: the drives (indices) whose reports stopped or held no number: left out of the estimate.
+    blind: the drives heard cannot determine the motion by themselves (none heard, or the
+    differential robot's one wheel); the twist is then the heard drives' speed along the last
+    commanded motion, or zero with none heard (see BaseCalculator.calculate_odometry).
     """
 
     twist: Twist
@@ -82,3 +89,10 @@ class OdometryResult:
     dt: float
     valid: bool = True
     translating: Optional[bool] = None  # the paper estimator's translation test; None for least squares
+    unheard: Tuple[int, ...] = ()
+    blind: bool = False
+
+    @property
+    def degraded(self) -> bool:
+        """Some drive is unheard: the estimate rests on fewer wheels than the robot has."""
+        return bool(self.unheard)
