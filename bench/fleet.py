@@ -159,9 +159,8 @@ def raw_pybullet(n: int, physics: str, seconds: float = RAW_SECONDS) -> float:
     """CPU [s] per robot and simulated second of bare pybullet stepping n standard robots (6 m apart,
     commanded 0.3 m/s) at the preset's rate and iterations, in this process: the world built by the
     simulator's Simulation class."""
-    import pybullet as p  # noqa: PLC0415
-
     from thorvald_model.description import generate_urdf  # noqa: PLC0415
+    from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
     from thorvald_sim.physics import physics_settings  # noqa: PLC0415
     from thorvald_sim.robot import Pose2D  # noqa: PLC0415
     from thorvald_sim.simulation import Simulation  # noqa: PLC0415

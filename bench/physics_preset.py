@@ -24,11 +24,11 @@ import sys
 import time
 
 import numpy as np
-import pybullet as p
 
 from thorvald_base.verification import plan_for
 from thorvald_model import load_robot_config
 from thorvald_model.description import generate_urdf
+from thorvald_sim.bullet import pybullet as p
 from thorvald_sim.physics import PRESETS
 from thorvald_sim.robot import Pose2D
 from thorvald_sim.runner import RunOptions, commands_from_plan, run_robot

@@ -70,9 +70,8 @@ def raw_costs(wall: float, only=None, stop: Optional[threading.Event] = None, fi
     (of the sensor named only, or of each with a raw reference), on the standard robot with the bench
     sensors in the flat world, for wall seconds each (or until stop is set). fixed: the lidars' rays
     computed once from the mount's first pose (cameras left out), as this bench measured before."""
-    import pybullet as p  # noqa: PLC0415
-
     from thorvald_model.description import generate_urdf  # noqa: PLC0415
+    from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
     from thorvald_sim.robot import Pose2D  # noqa: PLC0415
     from thorvald_sim.simulation import Simulation  # noqa: PLC0415
     from thorvald_sim.world import load_world, resolve_world  # noqa: PLC0415

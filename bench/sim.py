@@ -52,9 +52,8 @@ def world(n: int):
     frictions and damping the node steps (an earlier hand-made copy of those settings kept
     pybullet's default drag of 0.04 /s, which the simulator removes, and stepped 18 % cheaper).
     """
-    import pybullet as p  # noqa: PLC0415
-
     from thorvald_model.description import generate_urdf  # noqa: PLC0415
+    from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
     from thorvald_sim.robot import Pose2D  # noqa: PLC0415
     from thorvald_sim.simulation import Simulation  # noqa: PLC0415
     from thorvald_sim.world import load_world, resolve_world  # noqa: PLC0415
@@ -72,7 +71,7 @@ def world(n: int):
 
 def raw(n: int, seconds: float):
     """(real-time factor, CPU [s] per simulated second) of bare pybullet.stepSimulation, n robots."""
-    import pybullet as p  # noqa: PLC0415
+    from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
 
     c, _ = world(n)
     try:
@@ -88,7 +87,7 @@ def raw(n: int, seconds: float):
 
 def core(n: int, seconds: float):
     """CPU [s] per simulated second of the simulator's Simulation.step (ramps, springs: Python) for n robots."""
-    import pybullet as p  # noqa: PLC0415
+    from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
 
     c, sim = world(n)
     try:

@@ -24,9 +24,8 @@ import statistics
 import sys
 import time
 
-import pybullet as p
-
 from thorvald_model.description import generate_urdf
+from thorvald_sim.bullet import pybullet as p
 from thorvald_sim.robot import Pose2D
 from thorvald_sim.scene import build_scene
 from thorvald_sim.simulation import Simulation

@@ -39,6 +39,7 @@ NOT_PURE = {
     "thorvald_bringup.report_bag": "reads a rosbag, whose messages are genpy's",
     "thorvald_bringup.record_node": "a node: record_drive, a bag recorder that drops nothing",
     "thorvald_base.calibration_cli": "calibrate_odometry reads a rosbag, whose messages are genpy's",
+    "thorvald_sim.bullet": "pybullet itself, imported without its build-time line",
     "thorvald_sim.scene": "the simulator's physics (pybullet)",
     "thorvald_sim.robot": "the simulator's physics (pybullet)",
     "thorvald_sim.simulation": "the simulator's physics (pybullet)",

@@ -30,22 +30,20 @@ No ROS here: the simulator node converts messages. The pybullet client id is pas
   ``mass_offset`` on the frame.
 """
 
-import contextlib
 import math
 import os
-import sys
 import tempfile
 import xml.etree.ElementTree as ET
 from collections import deque
 from dataclasses import dataclass
 from typing import List, Optional, Sequence, Set, Tuple, Union
 
-import pybullet as p
-
 from thorvald_base.bases import MeasuredDrive
 from thorvald_model.motors import winding_current
 
 from .as_built import BuiltDrive, SimAsBuilt
+from .bullet import pybullet as p
+from .bullet import quiet_stdout
 from .description import (
     DescriptionError,
     RobotDescription,
@@ -455,21 +453,6 @@ class SimRobot:
 
     def remove(self) -> None:
         p.removeBody(self.body, physicsClientId=self.client)
-
-
-@contextlib.contextmanager
-def quiet_stdout():
-    """pybullet's C++ prints on file descriptor 1 (every merged link while loading, warnings while
-    building shapes): silence it meanwhile."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    try:
-        with open(os.devnull, "w") as null:
-            os.dup2(null.fileno(), 1)
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)
 
 
 def yaw_of(quat: Quat) -> float:

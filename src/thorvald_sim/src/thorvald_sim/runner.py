@@ -41,7 +41,6 @@ from dataclasses import dataclass, field, fields
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
-import pybullet as p
 
 from thorvald_base.bases import create_base_handle
 from thorvald_base.bases.handle import Ports
@@ -56,6 +55,7 @@ from thorvald_model.description import generate_urdf
 from thorvald_model.errors import MISSING, ConfigError, Problem
 
 from .as_built import as_built_for, for_simulator
+from .bullet import pybullet as p
 from .physics import physics_settings
 from .robot import Pose2D, Vec3
 from .simulation import Simulation

@@ -63,9 +63,9 @@ from dataclasses import dataclass
 from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Tuple
 
 import numpy as np
-import pybullet as p
 
-from .robot import quiet_stdout
+from .bullet import pybullet as p
+from .bullet import quiet_stdout
 from .world import (
     GROUND_THICKNESS,
     PATCH_TOP,

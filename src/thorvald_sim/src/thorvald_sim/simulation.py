@@ -9,11 +9,11 @@ from dataclasses import dataclass
 from typing import Dict, Optional, Tuple
 
 import numpy as np
-import pybullet as p
 
 from thorvald_model.urdf_check import UrdfCheckError
 
 from .as_built import SimAsBuilt
+from .bullet import pybullet as p
 from .description import DescriptionError, MeshFinder, mesh_finder, spawned_description
 from .errors import SpawnError
 from .physics import PRESETS

@@ -109,7 +109,6 @@ import tempfile
 import threading
 import time
 
-import pybullet as p
 import rosgraph
 import rospy
 from diagnostic_msgs.msg import DiagnosticArray
@@ -136,6 +135,7 @@ from thorvald_msgs.srv import (
 )
 
 from .as_built import SimAsBuilt
+from .bullet import pybullet as p
 from .commands import APPLY, HOLD, CommandSlot
 from .errors import ParameterError, SpawnError
 from .lockstep import Lockstep

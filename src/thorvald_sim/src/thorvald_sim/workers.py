@@ -499,7 +499,7 @@ def physics_rate_ok(rate) -> bool:
 # ---------------------------------------------------------------------------------------------
 def footprint_radius(robot) -> float:
     """[m] from base_link to the farthest corner of its links' bounding boxes in the world's xy, at spawn."""
-    import pybullet as p  # noqa: PLC0415  (the worker's side: the node never calls it)
+    from .bullet import pybullet as p  # noqa: PLC0415  (the worker's side: the node never calls it)
 
     (x, y, _), _ = robot.world_pose()
     radius = 0.0
@@ -516,7 +516,7 @@ class Engine:
     (:meth:`handle`). Usable in one process too (the tests compare it with a plain Simulation)."""
 
     def __init__(self, settings: WorldSettings):
-        import pybullet as p  # noqa: PLC0415  (the worker's side: the node never calls it)
+        from .bullet import pybullet as p  # noqa: PLC0415  (the worker's side: the node never calls it)
 
         self.client = p.connect(p.DIRECT)
         s = settings

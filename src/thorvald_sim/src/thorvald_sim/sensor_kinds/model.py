@@ -23,7 +23,7 @@ class _Pybullet:
     is looked up once, then held as an attribute."""
 
     def __getattr__(self, name: str):
-        import pybullet  # noqa: PLC0415 (on purpose: see the class's docstring)
+        from ..bullet import pybullet  # noqa: PLC0415 (on purpose: see the class's docstring)
 
         value = getattr(pybullet, name)
         setattr(self, name, value)
