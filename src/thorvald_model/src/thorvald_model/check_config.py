@@ -44,7 +44,8 @@ def summary(config: RobotConfig) -> dict:
         "suspended": sum(1 for d in config.drives if d.suspension is not None),
         "track": round(config.track, 4),
         "wheelbase": round(config.wheelbase, 4),
-        "batteries": len(config.batteries),
+        "batteries": len(config.present_batteries),  # a module with with_battery: 0 is an empty enclosure
+        "battery_modules": len(config.batteries),
     }
 
 
@@ -99,7 +100,9 @@ def format_details(config: RobotConfig) -> str:
         ),
         "  passive     {} wheels ({} casters, {} fixed)".format(s["passive"], s["casters"], s["fixed"]),
         "  track       {:.3f} m, wheelbase {:.3f} m".format(s["track"], s["wheelbase"]),
-        "  batteries   {}".format(s["batteries"]),
+        "  batteries   {} (in {} battery module{})".format(
+            s["batteries"], s["battery_modules"], "" if s["battery_modules"] == 1 else "s"
+        ),
         "",
         "  drive   node type   x [m]   y [m]  r [m]  str_lim [deg]  max speed [m/s]",
     ]

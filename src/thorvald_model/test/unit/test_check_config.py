@@ -61,6 +61,17 @@ def test_several_files_print_a_table(capsys):
     assert lines[1].split()[:5] == ["paper_figure5", "4", "4", "4", "0"]
 
 
+def test_batteries_count_the_modules_that_hold_one(capsys):
+    """The standard robot has two battery modules, the second with with_battery: 0 (an empty
+    enclosure): one battery."""
+    std = next(p for p in EXAMPLE_ROBOTS if p.endswith("thorvald_ii_4wd4ws_std.yaml"))
+    assert main([std]) == 0
+    assert "  batteries   1 (in 2 battery modules)" in capsys.readouterr().out.splitlines()
+    assert main(["--json", std]) == 0
+    (row,) = json.loads(capsys.readouterr().out)
+    assert (row["batteries"], row["battery_modules"]) == (1, 2)
+
+
 def test_json_summary(capsys):
     assert main(["--json", FIGURE5]) == 0
     (row,) = json.loads(capsys.readouterr().out)
