@@ -52,6 +52,19 @@ class ConfigError(ThorvaldModelError):
         super().__init__("\n".join([header] + ["  " + line for line in lines]))
 
 
+class UnknownRobotError(ThorvaldModelError, LookupError):
+    """A robot named by a name that is none of the example robots' (:mod:`thorvald_model.examples`).
+
+    ``rule`` is the broken rule in words, without the name, for a :class:`Problem` of the key that
+    names it (a study's ``robot:``); the message is the rule with the name, one line.
+    """
+
+    def __init__(self, name: str, rule: str):
+        super().__init__(f"{name!r}: {rule}")
+        self.name = name
+        self.rule = rule
+
+
 class PluginError(ThorvaldModelError):
     """A plugin the robot file names (``base_calculator``) cannot be found or loaded
     (:mod:`thorvald_model.plugins`).

@@ -11,6 +11,7 @@ import pytest
 
 from thorvald_model.description import package_file
 from thorvald_model.errors import ConfigError
+from thorvald_sim.run_robot import build_parser
 from thorvald_sim.runner import (
     RunOptions,
     TimedTwist,
@@ -121,6 +122,46 @@ def test_the_command_line_writes_its_files_and_refuses_a_broken_commands_file(tm
     bad = subprocess.run(argv, capture_output=True, text=True, timeout=300)
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
     assert "line 3.vx: 'x': must be a number" in bad.stderr
+
+
+@pytest.mark.slow  # a process per case: the command as a user types it
+def test_the_command_line_takes_an_example_robots_name_as_the_other_tools_do(tmp_path):
+    cmds = tmp_path / "cmds.csv"
+    cmds.write_text("t,vx,vy,wz\n0.2,0.5,0,0\n1.2,0,0,0\n")
+    out = tmp_path / "out"
+
+    def run_robot_command(robot, out):
+        argv = [sys.executable, "-m", "thorvald_sim.run_robot", robot, "--commands", str(cmds), "--out", str(out)]
+        return subprocess.run([*argv, "--hold", "0.3"], capture_output=True, text=True, timeout=300)
+
+    run = run_robot_command("thorvald_ii_2wd_diff", out)
+    assert run.returncode == 0, run.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["robot"] == package_file("config", "thorvald_ii_2wd_diff", "thorvald_ii_2wd_diff.yaml")
+    assert summary["simulated_s"] == pytest.approx(1.5) and summary["distance_truth_m"] == pytest.approx(0.5, abs=0.05)
+    misspelt = run_robot_command("thorvald_ii_2wd_dif", tmp_path / "none")
+    assert misspelt.returncode == 2 and "Traceback" not in misspelt.stderr
+    assert (
+        "run_robot: ROBOT 'thorvald_ii_2wd_dif': no example robot of that name (did you mean 'thorvald_ii_2wd_diff'?);"
+        " the examples: thorvald_ii_1wd1ws_fwd, " in misspelt.stderr
+    )
+    assert not os.path.exists(tmp_path / "none")  # refused before anything ran
+
+
+def test_the_help_documents_every_option_and_the_commands_file():
+    parser = build_parser()
+    text = parser.format_help()
+    for action in parser._actions:
+        assert action.help, action.option_strings  # every option says what it is
+    for option in ("--world", "--seed", "--calibration", "--model-extras", "--record-sensors", "--as-built", "--hold"):
+        assert option in text
+    commands = text[text.index("the commands file (--commands):") :]
+    for words in ("t,vx,vy,wz", "[m/s]", "[rad/s]", "base_link", "x forward, y left", "holds from its t until the next",
+                  "--hold seconds more", "the wheels stand"):  # fmt: skip
+        assert words in commands, words
+    example = commands[commands.index("    t,vx,vy,wz\n") : commands.index("outputs (DIR):")]
+    parsed = parse_commands(rows(example))  # the example is a commands file the runner reads
+    assert [c.t for c in parsed] == [0.5, 4.5, 8.5] and parsed[1].wz * 4.0 == pytest.approx(math.pi / 2, abs=1e-4)
 
 
 def test_the_fleet_physics_preset_keeps_the_papers_figures_at_half_the_rate():
