@@ -17,7 +17,8 @@ A study file::
       turning: {}
 
 A robot file named by a relative path is found from the study file's folder; a bare name without
-``.yaml`` is an example robot (``thorvald_model/config/NAME/NAME.yaml``).
+``.yaml`` is an example robot (``thorvald_model/config/NAME/NAME.yaml``, :mod:`thorvald_model.examples`:
+a mistyped one gets "did you mean").
 
 A sweep's key path is a robot file's (``motor_drives.drive0.r_wheel``); ``*`` stands for every entry
 of a section (``motor_drives.*.y``). A number set through ``*`` keeps each entry's sign, so that a
@@ -26,6 +27,13 @@ right ones at -0.75 m. Every combination of the sweep's values is one candidate,
 ``NAME[y=0.75]`` (``NAME[y=0.75,r_wheel=0.25]``), whose robot file the study writes (and checks with
 the robot files' own loader) before anything runs.
 
+A sweep that would change nothing is refused before anything runs, as a broken one is: a key path the
+robot files' schema does not know (a robot file may carry keys of its owner's for their own xacro,
+but a study's candidates have no xacro of their own: nothing would read it), a key that holds no
+number, and combinations that make the same robot as its runs read it (:func:`as_read`: a key nothing
+reads for those entries, such as a steering key of a drive that does not steer, or values the loader
+reads as one). So are values that would give two candidates one name.
+
 A payload is a box of its mass [kg] on the frame, centred at (x, y, z) in base_link [m], added to the
 robot file as a frame part, so the description, its mass properties and the physics all carry it.
 
@@ -33,7 +41,9 @@ Pure: YAML in, frozen values out (no ROS, no pybullet).
 """
 
 import copy
+import difflib
 import itertools
+import json
 import math
 import os
 import re
@@ -41,8 +51,10 @@ from dataclasses import dataclass
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 from thorvald_model.config import parse_robot_config
-from thorvald_model.description import package_file
-from thorvald_model.errors import MISSING, ConfigError, Problem
+from thorvald_model.errors import MISSING, ConfigError, Problem, UnknownRobotError
+from thorvald_model.examples import names_a_file, robot_file
+from thorvald_model.keys import SECTIONS
+from thorvald_model.motors import STEERING_KEYS
 from thorvald_model.plugins import calculator_problems
 from thorvald_model.schema import (
     NON_NEGATIVE,
@@ -81,6 +93,58 @@ PAYLOAD_KEYS = (
     Key("z", float, 0.8),
 )
 KNOWN = ("description", "seed", "candidates", "scenarios", "optimise", "pareto")
+SWEEP_KINDS = (float, int, bool)  # of the keys a sweep can set: its values are numbers (a bool's 0 or 1)
+
+# Words a designer may write for the original's abbreviated keys, for "did you mean": difflib finds a
+# typing mistake (r_wheeel: 0.93 alike) but not another word for the thing (width and w_wheel: 0.33).
+# Through *, x and y keep each entry's sign: a half wheelbase and a half track.
+SPELLED_OUT = {
+    "x": "half_wheelbase",
+    "y": "half_track",
+    "r_wheel": "wheel_radius",
+    "w_wheel": "wheel_width",
+    "prp_gr_rt": "propulsion_gear_ratio",
+    "prp_enc_ppr": "propulsion_encoder_ppr",
+    "prp_max_rpm": "propulsion_max_rpm",
+    "prp_sim_a": "acceleration",
+    "str_gr_rt": "steering_gear_ratio",
+    "str_enc_ppr": "steering_encoder_ppr",
+    "str_lim": "steering_limit",
+    "str_sim_v": "steering_speed",
+    "prp_motor_torque": "propulsion_motor_torque",
+    "str_motor_torque": "steering_motor_torque",
+    "prp_motor_kt": "propulsion_torque_constant",
+    "prp_motor_r": "propulsion_motor_resistance",
+    "prp_motor_i0": "propulsion_no_load_current",
+    "prp_gear_eff": "propulsion_gear_efficiency",
+    "str_motor_kt": "steering_torque_constant",
+    "str_motor_r": "steering_motor_resistance",
+    "str_motor_i0": "steering_no_load_current",
+    "str_gear_eff": "steering_gear_efficiency",
+    "rail_r_wheel": "rail_wheel_radius",
+    "rail_w_wheel": "rail_wheel_width",
+}
+
+# What nothing reads for an entry's kind, so that a sweep of it changes nothing: (section, whether an
+# entry's key is unread, why). A drive that does not steer stands on a fixed joint in the description
+# and base_driver commands it no steering (thorvald_model.motors: "nothing reads" its steering
+# motor); an enclosure without a KC battery holds no pack (energy, the CAN emulator and base_driver
+# take the fitted batteries only); a fixed wheel has no trail (the description's caster fork only).
+STEERING_ONLY = (*STEERING_KEYS, "str_enc_ppr", "str_lim", "str_sim_v", "str_motor_torque", "steering_offset")
+PACK_KEYS = ("capacity", "voltage", "internal_resistance")
+UNREAD = (
+    (
+        "motor_drives",
+        lambda d, key: not d.steerable and key in STEERING_ONLY,
+        "a drive that does not steer (type 1) has a fixed leg: nothing reads its steering keys",
+    ),
+    (
+        "batteries",
+        lambda b, key: not b.present and key in PACK_KEYS,
+        "an enclosure without a KC battery (type 0, or with_battery 0) holds no pack",
+    ),
+    ("passive_wheels", lambda w, key: w.fixed and key == "caster_offset", "a fixed wheel has no caster trail"),
+)
 
 
 @dataclass(frozen=True)
@@ -122,7 +186,7 @@ class Space:
         swept = tuple((key_path, float(values[key_path])) for key_path, _ in self.dimensions)
         problems: List[Problem] = []
         robot = _applied(self.robot_data, swept, self.payload, self.name, problems)
-        label = self.name + "[" + ",".join(f"{k.split('.')[-1]}={v:g}" for k, v in swept) + "]"
+        label = _label(self.name, swept)
         if robot is None or problems:
             raise ValueError(f"{label}: " + "; ".join(f"{p.path}: {p.rule}" for p in problems))
         config = parse_robot_config(robot, f"{self.robot_file} ({label})")  # ConfigError: refused
@@ -256,7 +320,9 @@ def _candidate(
     plain = {k: v for k, v in entry.items() if k not in ("payload", "sweep")}
     values = parse_entry(plain, path, CANDIDATE_KEYS, problems)
     payload = _payload(entry.get("payload"), f"{path}.payload", problems)
+    found = len(problems)
     sweep = _sweep(entry.get("sweep"), f"{path}.sweep", problems)
+    swept_well = len(problems) == found
     if values is None:
         return []
     robot_file = _robot_file(values["robot"], base_dir, f"{path}.robot", problems)
@@ -267,10 +333,13 @@ def _candidate(
     except ConfigError as e:
         problems.append(Problem(f"{path}.robot", values["robot"], str(e)))
         return []
+    if not swept_well:  # nothing to make of a sweep that names what is not there
+        return []
     ranges = [key_path for key_path, dimension in sweep if isinstance(dimension, Range)]
     if spaces is not None:  # the search's space (--optimise); swept too when it has no range
         spaces.append(Space(name, robot_file, data, values["as_built"], payload, tuple(sweep)))
         if ranges:
+            _each_dimension_changes_the_robot(spaces[-1], path, problems)
             return []
     if ranges:
         rule = "is a range {min, max}: only a search (optimise: candidate: " + name + ") runs one"
@@ -282,38 +351,116 @@ def _candidate(
         problems.append(Problem(f"{path}.sweep", MISSING, rule))
         return []
     out = []
+    read: Dict[str, Tuple[Candidate, Any]] = {}  # a robot as its runs read it -> the first making it, its config
+    same: Dict[Tuple[str, ...], Tuple[Candidate, Candidate, Any]] = {}  # key paths -> two combinations alike
     combos = itertools.product(*(values_ for _, values_ in sweep)) if sweep else [()]
     for combo in combos:
         swept = tuple((key_path, value) for (key_path, _), value in zip(sweep, combo))
         robot = _applied(data, swept, payload, f"{path}.sweep", problems)
-        if robot is None:
+        if robot is None:  # a key path names no entry of the file: the same for every combination
+            break
+        label = _label(name, swept)
+        config = _checked(robot, f"{robot_file} ({label})", path, label, problems)
+        if config is None:
             continue
-        label = name + ("[" + ",".join(f"{k.split('.')[-1]}={v:g}" for k, v in swept) + "]" if swept else "")
-        source = f"{robot_file} ({label})"
-        try:
-            config = parse_robot_config(robot, source)
-            refused = calculator_problems(config)  # its calculator must serve its layout, as base_driver checks
-            if refused:
-                raise ConfigError(source, refused)
-        except ConfigError as e:
-            problems.append(Problem(path, label, f"makes a robot the robot files' rules refuse:\n{e}"))
-            continue
-        out.append(
-            Candidate(label, robot_file, robot, values["as_built"], payload, swept, family=name if swept else "")
-        )
+        family = name if swept else ""
+        candidate = Candidate(label, robot_file, robot, values["as_built"], payload, swept, family=family)
+        out.append(candidate)
+        first, first_config = read.setdefault(_fingerprint(config), (candidate, config))
+        if first is not candidate:
+            differ = tuple(k for (k, a), (_, b) in zip(first.swept, candidate.swept) if a != b)
+            same.setdefault(differ, (first, candidate, first_config))
+    for differ, (a, b, config) in same.items():
+        for key_path in differ:
+            values_ = [dict(a.swept)[key_path], dict(b.swept)[key_path]]
+            rule = f"{a.name} and {b.name} make the same robot: " + _why_the_same(key_path, config)
+            problems.append(Problem(f"{path}.sweep.{key_path}", values_, rule))
     return out
 
 
-def _robot_file(value: str, base_dir: str, path: str, problems: List[Problem]) -> Optional[str]:
-    if not value.endswith((".yaml", ".yml")) and os.sep not in value:
-        found = package_file("config", value, value + ".yaml")
-        if os.path.isfile(found):
-            return found
-        examples = sorted(os.listdir(package_file("config")))
-        problems.append(Problem(path, value, "no example robot of that name (examples: " + ", ".join(examples) + ")"))
+def _checked(robot: Mapping, source: str, path: str, label: str, problems: List[Problem]):
+    """The robot's configuration as its runs load it; None (a problem recorded) if the robot files'
+    rules or its calculator (as base_driver checks) refuse it."""
+    try:
+        config = parse_robot_config(robot, source)
+        refused = calculator_problems(config)
+        if refused:
+            raise ConfigError(source, refused)
+    except ConfigError as e:
+        problems.append(Problem(path, label, f"makes a robot the robot files' rules refuse:\n{e}"))
         return None
-    full = os.path.normpath(os.path.join(base_dir, os.path.expanduser(value)))
-    if not os.path.isfile(full):
+    return config
+
+
+def _each_dimension_changes_the_robot(space: Space, path: str, problems: List[Problem]) -> None:
+    """A search's space (a sweep with a range, which no sweep expands): each key path's values, the
+    others at their first (a range at its min), make robots the rules take and that differ; a range
+    from its min to its max."""
+    base = [(k, dimension.min if isinstance(dimension, Range) else dimension[0]) for k, dimension in space.dimensions]
+    for i, (key_path, dimension) in enumerate(space.dimensions):
+        values_ = (dimension.min, dimension.max) if isinstance(dimension, Range) else dimension
+        seen: Dict[str, float] = {}
+        for value in values_:
+            swept = tuple([*base[:i], (key_path, value), *base[i + 1 :]])
+            robot = _applied(space.robot_data, swept, space.payload, f"{path}.sweep", problems)
+            if robot is None:
+                return
+            label = _label(space.name, swept)
+            config = _checked(robot, f"{space.robot_file} ({label})", path, label, problems)
+            if config is None:
+                return
+            first = seen.setdefault(_fingerprint(config), value)
+            if first != value:
+                which = f"{first:g} and {value:g}"
+                which = f"the range's min and max, {which}," if isinstance(dimension, Range) else which
+                rule = f"{which} make the same robot: " + _why_the_same(key_path, config)
+                problems.append(Problem(f"{path}.sweep.{key_path}", [first, value], rule))
+                break
+
+
+def _label(name: str, swept: Sequence[Tuple[str, float]]) -> str:
+    """A combination's candidate name: NAME[KEY=VALUE,...], each value to 6 significant digits."""
+    return name + ("[" + ",".join(f"{k.split('.')[-1]}={v:g}" for k, v in swept) + "]" if swept else "")
+
+
+def as_read(config) -> Dict[str, Any]:
+    """The robot file as a study's runs read it: every default filled in and every alias resolved
+    (``RobotConfig.to_dict``, which leaves out what the loader drops), less what nothing reads for an
+    entry's kind (:data:`UNREAD`). Two combinations of a sweep with the same are the same robot."""
+    out = config.to_dict()
+    for section, unread, _ in UNREAD:
+        for item in getattr(config, _ATTR[section]):
+            entry = out[section][item.name]
+            for key in [k for k in entry if unread(item, k)]:
+                del entry[key]
+    return out
+
+
+_ATTR = {s.key: s.attr for s in SECTIONS}
+
+
+def _fingerprint(config) -> str:
+    return json.dumps(as_read(config), sort_keys=True, default=repr)
+
+
+def _why_the_same(key_path: str, config) -> str:
+    """Why a key path's values make one robot: what nothing reads for the kind of every entry it sets,
+    else the loader reading the values as one."""
+    section, entry, key = key_path.split(".")
+    items = [i for i in getattr(config, _ATTR[section]) if entry in ("*", i.name)]
+    for unread_section, unread, why in UNREAD:
+        if unread_section == section and items and all(unread(i, key) for i in items):
+            return f"{why} ({', '.join(i.name for i in items)})"
+    return "the robot files' loader reads the values as the same"
+
+
+def _robot_file(value: str, base_dir: str, path: str, problems: List[Problem]) -> Optional[str]:
+    try:
+        full = robot_file(value, base_dir)
+    except UnknownRobotError as e:
+        problems.append(Problem(path, value, e.rule))
+        return None
+    if names_a_file(value) and not os.path.isfile(full):
         problems.append(Problem(path, value, f"no such file: {full} (a relative path is from the study file's folder)"))
         return None
     return full
@@ -342,6 +489,8 @@ def _sweep(raw: Any, path: str, problems: List[Problem]) -> List[Tuple[str, Any]
             rule = "must be a robot file's key path SECTION.ENTRY.KEY (ENTRY may be *), e.g. motor_drives.*.y"
             problems.append(Problem(where, short(values), rule))
             continue
+        if not _schema_key(parts, where, values, problems):
+            continue
         if isinstance(values, Mapping):  # {min, max}: a range a search explores
             found = parse_range(values, where, problems)
             if found is not None:
@@ -363,8 +512,60 @@ def _sweep(raw: Any, path: str, problems: List[Problem]) -> List[Tuple[str, Any]
             if len(set(numbers)) != len(numbers):
                 problems.append(Problem(where, short(values), "the values must differ"))
                 continue
-            out.append((str(key_path), tuple(numbers)))
+            named = {}
+            for v in numbers:
+                other = named.setdefault(f"{v:g}", v)
+                if other != v:
+                    rule = (
+                        f"{other!r} and {v!r} would name one candidate ({parts[2]}={v:g}): "
+                        "names keep 6 significant digits"
+                    )
+                    problems.append(Problem(where, short(values), rule))
+                    break
+            else:
+                out.append((str(key_path), tuple(numbers)))
     return out
+
+
+def _schema_keys(section: str) -> Dict[str, Key]:
+    """The keys of a section's entries by name and alias (the robot files' schema,
+    :mod:`thorvald_model.keys`); empty for a section the schema does not have."""
+    for s in SECTIONS:
+        if s.key == section:
+            return {**{a: k for k in s.keys for a in k.aliases}, **{k.name: k for k in s.keys}}
+    return {}
+
+
+def _schema_key(parts: Sequence[str], where: str, values: Any, problems: List[Problem]) -> bool:
+    """Whether a sweep's key path names a number key the robot files' schema knows; a problem with
+    "did you mean" if not. A robot file may carry keys of its owner's (the loader keeps them for the
+    owner's xacro), but a study's candidate has no xacro of its own: swept, such a key changes nothing."""
+    section, _, key = parts
+    known = _schema_keys(section)
+    if not known:
+        sections = [s.key for s in SECTIONS]
+        close = difflib.get_close_matches(section, sections, n=1, cutoff=0.6)
+        hint = f"did you mean {close[0]!r}?" if close else "its sections: " + ", ".join(sections)
+        rule = f"the robot files' schema has no section {section!r}: a sweep of it would change nothing ({hint})"
+        problems.append(Problem(where, short(values), rule))
+        return False
+    if key not in known:
+        close = difflib.get_close_matches(key, sorted(known), n=1, cutoff=0.6)
+        if not close:  # another word for an abbreviated key (width for w_wheel)
+            words = {SPELLED_OUT[k]: k for k in known if k in SPELLED_OUT}
+            close = [words[w] for w in difflib.get_close_matches(key, sorted(words), n=1, cutoff=0.6)]
+        hint = f"did you mean {close[0]!r}?" if close else f"the keys of {section} entries: " + ", ".join(sorted(known))
+        rule = (
+            f"the robot files' schema has no key {key!r} in {section} entries: nothing reads it, so a sweep of it "
+            f"would change nothing ({hint})"
+        )
+        problems.append(Problem(where, short(values), rule))
+        return False
+    if known[key].kind not in SWEEP_KINDS:
+        rule = f"{section} entries' {key!r} is not a number (a sweep's values are numbers)"
+        problems.append(Problem(where, short(values), rule))
+        return False
+    return True
 
 
 def _applied(
@@ -389,7 +590,7 @@ def _applied(
             old = entries[name].get(key)
             # through *, a number keeps each entry's sign: a symmetric robot stays symmetric
             signed = -value if entry == "*" and isinstance(old, (int, float)) and old < 0 else value
-            entries[name] = {**entries[name], key: signed}
+            entries[name] = {**entries[name], key: _as_kind(signed, _schema_keys(section).get(key))}
     if payload is not None:
         parts = dict(robot.get("frame_parts") or {})
         size_x, size_y, size_z = PAYLOAD_SIZE
@@ -401,9 +602,19 @@ def _applied(
     return robot
 
 
+def _as_kind(value: float, key: Optional[Key]) -> Any:
+    """A swept number as its key's kind: a whole number for an integer key (1024, not 1024.0, as a
+    file has it) and 0 or 1 as false or true, which the loader reads for a flag; anything else as it is
+    (the loader then names the rule it breaks)."""
+    if key is not None and key.kind in (int, bool) and float(value).is_integer():
+        number = int(value)
+        return bool(number) if key.kind is bool and number in (0, 1) else number
+    return value
+
+
 def _like(name: str, known: Mapping) -> str:
     close = close_key(name, [str(k) for k in known])
     return f" (did you mean {close!r}?)" if close else ""
 
 
-__all__ = ["Candidate", "Payload", "Space", "Study", "load_study", "parse_study"]
+__all__ = ["Candidate", "Payload", "Space", "Study", "as_read", "load_study", "parse_study"]

@@ -227,6 +227,41 @@ def test_a_broken_study_is_refused_before_anything_runs(tmp_path):
     assert "Traceback" not in done.stderr and not os.path.exists(tmp_path / "out")
 
 
+@pytest.mark.slow  # a process: the command as a user types it
+def test_a_sweep_that_would_change_nothing_is_refused_before_anything_runs(tmp_path):
+    """Issue 45: a sweep of a key no robot file has ran every combination with a warning a drive, and
+    gave identical results."""
+    path = tmp_path / "study.yaml"
+    path.write_text(
+        "candidates:\n  wide:\n    robot: thorvald_ii_4wd4ws_std\n"
+        '    sweep: {"motor_drives.*.width": [0.5, 0.6]}\n'
+        "scenarios: {turning: {settle: 1}}\n"
+    )
+    done = design_study(str(path), "--out", str(tmp_path / "out"), timeout=120)
+    assert done.returncode == 2, done.stderr[-2000:]
+    assert (
+        f"{path}: candidates.wide.sweep.motor_drives.*.width: [0.5, 0.6]: the robot files' schema has no key "
+        "'width' in motor_drives entries: nothing reads it, so a sweep of it would change nothing "
+        "(did you mean 'w_wheel'?)" in done.stderr
+    )
+    assert "Traceback" not in done.stderr and "kept as it is" not in done.stderr
+    assert " scenarios = " not in done.stderr and done.stdout == ""  # no run started: none announced, no table
+    assert not os.path.exists(tmp_path / "out")
+
+
+@pytest.mark.slow  # a process
+def test_a_mistyped_example_robot_gets_did_you_mean(tmp_path):
+    path = tmp_path / "study.yaml"
+    path.write_text("candidates: {a: {robot: thorvald_ii_2wd_dif}}\nscenarios: {turning: {}}\n")
+    done = design_study(str(path), "--out", str(tmp_path / "out"), timeout=120)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert (
+        "candidates.a.robot: 'thorvald_ii_2wd_dif': no example robot of that name (did you mean "
+        "'thorvald_ii_2wd_diff'?); the examples: thorvald_ii_1wd1ws_fwd" in done.stderr
+    )
+    assert not os.path.exists(tmp_path / "out")
+
+
 @pytest.mark.slow  # a process
 def test_a_candidate_that_cannot_be_built_fails_alone(tmp_path):
     """A candidate whose as-built file is missing is reported failed with its reason; the other runs."""

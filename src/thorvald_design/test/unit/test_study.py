@@ -110,7 +110,8 @@ def test_a_robot_file_is_found_from_the_study_files_folder(tmp_path):
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {gradeability: {start_deg: 30, max_deg: 20}}",
          "scenarios.gradeability.max_deg: 20.0: must be >= start_deg (30)"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_sdt}}\nscenarios: {turning: {}}",
-         "candidates.a.robot: 'thorvald_ii_4wd4ws_sdt': no example robot of that name"),
+         "candidates.a.robot: 'thorvald_ii_4wd4ws_sdt': no example robot of that name (did you mean "
+         "'thorvald_ii_4wd4ws_std'?); the examples: thorvald_ii_1wd1ws_fwd, "),
         ("candidates: {a: {robot: missing.yaml}}\nscenarios: {turning: {}}",
          "candidates.a.robot: 'missing.yaml': no such file"),
         ("candidates: {a: {robt: thorvald_ii_4wd4ws_std}}\nscenarios: {turning: {}}",
@@ -120,13 +121,21 @@ def test_a_robot_file_is_found_from_the_study_files_folder(tmp_path):
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std, sweep: {'motor_drives.*.y': [0.3, x]}}}\n"
          "scenarios: {turning: {}}", "'x' is not a finite number"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std, sweep: {'motor_drive.*.y': [0.3]}}}\n"
-         "scenarios: {turning: {}}", "the robot file has no section 'motor_drive' (did you mean 'motor_drives'?)"),
+         "scenarios: {turning: {}}", "candidates.a.sweep.motor_drive.*.y: [0.3]: the robot files' schema has no "
+         "section 'motor_drive': a sweep of it would change nothing (did you mean 'motor_drives'?)"),
+        ("candidates: {a: {robot: thorvald_ii_4wd4ws_std, sweep: {'suspensions.*.travel': [0.1]}}}\n"
+         "scenarios: {turning: {}}", "candidates.a.sweep.suspensions.*.travel: 0.1: the robot file has no section "
+         "'suspensions'"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std, sweep: {'motor_drives.drive9.y': [0.3]}}}\n"
          "scenarios: {turning: {}}", "has no entry 'drive9'"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std, sweep: {'motor_drives.*.r_wheel': [-0.2]}}}\n"
          "scenarios: {turning: {}}", "makes a robot the robot files' rules refuse"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std, payload: {mass: -3}}}\nscenarios: {turning: {}}",
          "candidates.a.payload.mass: -3: must be >= 0"),
+        ("candidates: {a: {robot: thorvald_ii_4wd4ws_std, payload: {mas: 80}}}\nscenarios: {turning: {}}",
+         "candidates.a.payload.mas: 80: unknown key (did you mean 'mass'?)"),
+        ("candidates: {a: {robot: thorvald_ii_4wd4ws_std, payload: {mass: 80, height: 1}}}\nscenarios: {turning: {}}",
+         "candidates.a.payload.height: 1: unknown key (known keys: mass, x, y, z)"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {turning: {}}\nsede: 3",
          "sede: 3: unknown key (did you mean 'seed'?)"),
         ("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}", "scenarios: <missing>: is required"),
@@ -140,6 +149,113 @@ def test_a_robot_file_is_found_from_the_study_files_folder(tmp_path):
 )  # fmt: skip
 def test_a_broken_study_names_the_key_path_the_value_and_the_rule(text, expected):
     assert expected in problems(text)
+
+
+@pytest.mark.parametrize(
+    "key_path, values, expected",
+    [
+        # issue 45: ran every combination with a warning for each drive, and the results were the same
+        ("motor_drives.*.width", "[0.5, 0.6]", "candidates.a.sweep.motor_drives.*.width: [0.5, 0.6]: the robot files' "
+         "schema has no key 'width' in motor_drives entries: nothing reads it, so a sweep of it would change nothing "
+         "(did you mean 'w_wheel'?)"),
+        ("motor_drives.*.radius", "[0.2, 0.25]", "no key 'radius' in motor_drives entries: nothing reads it, so a "
+         "sweep of it would change nothing (did you mean 'r_wheel'?)"),
+        ("motor_drives.*.track", "[0.5, 0.6]", "(did you mean 'y'?)"),
+        ("motor_drives.drive0.r_wheeel", "[0.2, 0.25]", "no key 'r_wheeel' in motor_drives entries: nothing reads it, "
+         "so a sweep of it would change nothing (did you mean 'r_wheel'?)"),
+        ("batteries.*.capacty", "[50, 80]", "(did you mean 'capacity'?)"),
+        ("motor_drives.*.zz", "[1, 2]", "(the keys of motor_drives entries: leg_mesh, node, prp_enc_ppr, "),
+        ("lidar_front.a.x", "[1, 2]", "candidates.a.sweep.lidar_front.a.x: [1, 2]: the robot files' schema has no "
+         "section 'lidar_front': a sweep of it would change nothing (its sections: motor_drives, batteries, "),
+        ("frame_parts.part0.shape", "[1, 2]", "candidates.a.sweep.frame_parts.part0.shape: [1, 2]: frame_parts "
+         "entries' 'shape' is not a number (a sweep's values are numbers)"),
+    ],
+)  # fmt: skip
+def test_a_sweep_of_a_key_the_schema_does_not_know_is_refused_with_did_you_mean(key_path, values, expected, caplog):
+    """A robot file may keep keys of its owner's, but a study's candidate has no xacro of its own that
+    could read one: a sweep of it would run every combination for nothing."""
+    text = problems(
+        f"candidates: {{a: {{robot: thorvald_ii_4wd4ws_std, sweep: {{'{key_path}': {values}}}}}}}\n"
+        "scenarios: {turning: {}}"
+    )
+    assert expected in text
+    assert "1 problem)" in text
+    assert "kept as it is" not in caplog.text  # refused before any combination was made and loaded
+
+
+def test_the_refusal_names_the_study_file_and_nothing_is_made(tmp_path, caplog):
+    path = tmp_path / "study.yaml"
+    path.write_text("candidates:\n  wide:\n    robot: thorvald_ii_4wd4ws_std\n"
+                    "    sweep: {'motor_drives.*.width': [0.5, 0.6]}\nscenarios: {turning: {}}\n")  # fmt: skip
+    with pytest.raises(ConfigError) as e:
+        load_study(str(path))
+    assert str(e.value).splitlines()[1].strip().startswith(f"{path}: candidates.wide.sweep.motor_drives.*.width: ")
+    assert caplog.records == []
+
+
+@pytest.mark.parametrize(
+    "robot, sweep, expected",
+    [
+        # the differential robot's two drives are type 1: a fixed leg, no steering
+        ("thorvald_ii_2wd_diff", "{'motor_drives.*.str_lim': [1.0, 2.0]}",
+         "candidates.a.sweep.motor_drives.*.str_lim: [1.0, 2.0]: a[str_lim=1] and a[str_lim=2] make the same robot: "
+         "a drive that does not steer (type 1) has a fixed leg: nothing reads its steering keys (drive0, drive1)"),
+        ("thorvald_ii_2wd_diff", "{'motor_drives.*.y': [0.3, 0.35], 'motor_drives.drive0.str_motor_kt': [0.1, 0.2]}",
+         "candidates.a.sweep.motor_drives.drive0.str_motor_kt: [0.1, 0.2]: a[y=0.3,str_motor_kt=0.1] and "
+         "a[y=0.3,str_motor_kt=0.2] make the same robot: a drive that does not steer (type 1) has a fixed leg: "
+         "nothing reads its steering keys (drive0)"),
+        # the standard robot's second enclosure holds no battery (with_battery: 0)
+        ("thorvald_ii_4wd4ws_std", "{'batteries.bat1.capacity': [50, 100]}",
+         "a[capacity=50] and a[capacity=100] make the same robot: an enclosure without a KC battery (type 0, or "
+         "with_battery 0) holds no pack (bat1)"),
+        # the front-driven robot's support wheels are fixed
+        ("thorvald_ii_1wd1ws_fwd", "{'passive_wheels.*.caster_offset': [0.05, 0.1]}",
+         "make the same robot: a fixed wheel has no caster trail (passive0, passive1)"),
+        # numbers that differ past the 6 digits a candidate's name keeps would give two candidates one name
+        ("thorvald_ii_4wd4ws_std", "{'motor_drives.*.y': [0.6, 0.6000001]}",
+         "candidates.a.sweep.motor_drives.*.y: [0.6, 0.6000001]: 0.6 and 0.6000001 would name one candidate "
+         "(y=0.6): names keep 6 significant digits"),
+    ],
+)  # fmt: skip
+def test_a_sweep_whose_combinations_make_the_same_robot_is_refused(robot, sweep, expected):
+    text = problems(f"candidates: {{a: {{robot: {robot}, sweep: {sweep}}}}}\nscenarios: {{turning: {{}}}}")
+    assert expected in text and "1 problem)" in text
+
+
+def test_a_key_read_by_some_of_the_entries_it_sets_is_a_sweep():
+    """The front-driven robot's one drive steers: its str_lim is read, so the two robots differ."""
+    s = study("candidates: {a: {robot: thorvald_ii_1wd1ws_fwd, sweep: {'motor_drives.*.str_lim': [1.0, 2.0]}}}\n"
+              "scenarios: {turning: {}}")  # fmt: skip
+    assert [c.name for c in s.candidates] == ["a[str_lim=1]", "a[str_lim=2]"]
+    assert [parse_robot_config(c.robot_data).drives[0].str_lim for c in s.candidates] == [1.0, 2.0]
+
+
+def test_swept_integers_and_flags_are_written_as_the_file_writes_them():
+    s = study("candidates: {a: {robot: thorvald_ii_4wd4ws_std, sweep: {'batteries.bat1.with_battery': [0, 1],"
+              " 'motor_drives.drive0.prp_enc_ppr': [2048]}}}\nscenarios: {turning: {}}")  # fmt: skip
+    fitted = [parse_robot_config(c.robot_data).batteries[1].with_battery for c in s.candidates]
+    assert fitted == [False, True]
+    drive0 = s.candidates[0].robot_data["motor_drives"]["drive0"]["prp_enc_ppr"]
+    assert drive0 == 2048 and isinstance(drive0, int)
+
+
+def test_a_searched_range_that_changes_nothing_is_refused():
+    """A range no sweep expands: its min and max, the other key paths at their first, must differ."""
+    text = problems(
+        "candidates: {a: {robot: thorvald_ii_2wd_diff, sweep: {'motor_drives.*.y': [0.3, 0.35],"
+        " 'motor_drives.*.str_sim_v': {min: 1, max: 4}}}}\nscenarios: {turning: {}}\n"
+        "optimise: {candidate: a, objectives: {turning.turning_diameter_m: min, turning.clearance_diameter_m: min}}"
+    )
+    assert (
+        "candidates.a.sweep.motor_drives.*.str_sim_v: [1.0, 4.0]: the range's min and max, 1 and 4, make the same "
+        "robot: a drive that does not steer (type 1) has a fixed leg" in text
+    )
+    searched = study(
+        "candidates: {a: {robot: thorvald_ii_2wd_diff, sweep: {'motor_drives.*.y': {min: 0.3, max: 0.4}}}}\n"
+        "scenarios: {turning: {}}\n"
+        "optimise: {candidate: a, objectives: {turning.turning_diameter_m: min, turning.clearance_diameter_m: min}}"
+    )
+    assert searched.space is not None and searched.candidates == ()
 
 
 def test_a_robot_its_calculator_cannot_serve_is_refused(tmp_path):
