@@ -29,7 +29,8 @@ from typing import List, Tuple
 
 from thorvald_base.stamped_commands import LOCKSTEP_BROKEN
 from thorvald_base.verification import MANOEUVRES, SIDE
-from thorvald_model import ConfigError, load_robot_config
+from thorvald_model import ConfigError, examples, load_robot_config
+from thorvald_model.errors import UnknownRobotError
 from thorvald_model.ports import free_port
 from thorvald_sim.as_built import PROFILES, as_built_for, describe_as_built
 from thorvald_sim.params import MAX_WORKERS
@@ -51,7 +52,7 @@ def parser() -> argparse.ArgumentParser:
     robot.add_argument(
         "--robot",
         default="thorvald_ii_6wd6ws_asym",
-        help="an example robot's name (default: the paper's Figure 7 robot)",
+        help="an example robot's name or a robot file (default: the paper's Figure 7 robot)",
     )
     robot.add_argument("--robot-model", metavar="FILE", help="a robot configuration file instead of an example robot")
     p.add_argument("--bag", metavar="FILE", help="report from this bag instead of driving")
@@ -99,17 +100,14 @@ def parser() -> argparse.ArgumentParser:
 
 
 def robot_file(args) -> str:
+    """The robot file of --robot-model, else of --robot: an example robot's name or a file, as every
+    tool takes it (thorvald_model.examples); UnknownRobot with "did you mean" for a name that is none."""
     if args.robot_model:
         return os.path.abspath(args.robot_model)
-    import rospkg  # noqa: PLC0415
-
-    config_dir = os.path.join(rospkg.RosPack().get_path("thorvald_model"), "config")
-    path = os.path.join(config_dir, args.robot, args.robot + ".yaml")
-    if not os.path.isfile(path):
-        raise UnknownRobot(
-            f"no example robot {args.robot!r}; the examples are: {' '.join(sorted(os.listdir(config_dir)))}"
-        )
-    return path
+    try:
+        return os.path.abspath(examples.robot_file(args.robot))
+    except UnknownRobotError as e:
+        raise UnknownRobot(f"--robot {e}") from None
 
 
 def drive(

@@ -45,7 +45,9 @@ def test_one_base_class_and_the_old_name_where_it_was():
 def test_odometry_report_says_each_error_in_one_line_and_exits_2(tmp_path, capsys, monkeypatch):
     assert main(["--robot", "no_such_robot", "--out", str(tmp_path)]) == 2
     (line,) = capsys.readouterr().err.splitlines()
-    assert line.startswith("odometry_report: no example robot 'no_such_robot'; the examples are: ")
+    assert line.startswith("odometry_report: --robot 'no_such_robot': no example robot of that name; the examples: ")
+    assert main(["--robot", "thorvald_ii_4wd4ws_sdt", "--out", str(tmp_path)]) == 2
+    assert "(did you mean 'thorvald_ii_4wd4ws_std'?)" in capsys.readouterr().err
     monkeypatch.setenv("PATH", str(tmp_path))  # no roslaunch: the drive cannot start
     assert main(["--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err

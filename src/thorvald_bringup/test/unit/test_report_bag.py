@@ -136,7 +136,11 @@ def test_odometry_report_refuses_a_bag_of_another_robot_and_a_bad_robot_with_one
     )
     assert "Traceback" not in r.stderr
     r = run_report("--robot", "no_such_robot", "--out", str(tmp_path))
-    assert r.returncode == 2 and "no example robot 'no_such_robot'" in r.stderr and "Traceback" not in r.stderr
+    assert (
+        r.returncode == 2
+        and "'no_such_robot': no example robot of that name" in r.stderr
+        and "Traceback" not in r.stderr
+    )
     bad = tmp_path / "bad.yaml"
     bad.write_text("base_calculator: 5\n")
     r = run_report("--robot-model", str(bad), "--bag", str(tmp_path / "drive.bag"), "--out", str(tmp_path))
