@@ -132,7 +132,7 @@ def _executor(args, runs: int):
         return _DaskExecutor(client), workers, f"{workers} Dask workers at {args.scheduler}"
     workers = min(args.jobs or os.cpu_count() or 1, max(runs, 1))
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
-    return pool, workers, f"{workers} worker processes"
+    return pool, workers, f"{workers} worker process{'' if workers == 1 else 'es'}"
 
 
 class _DaskExecutor:
