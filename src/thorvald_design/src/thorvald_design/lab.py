@@ -7,11 +7,10 @@ Not pure: it runs pybullet (one DIRECT client a session, closed at its end).
 """
 
 import math
-from dataclasses import dataclass
-from typing import Callable, List, Mapping, Optional, Sequence, Tuple
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
-import pybullet as p
-
+from thorvald_sim.bullet import pybullet as p
 from thorvald_sim.robot import MotorLoad
 from thorvald_sim.runner import RobotSession, RunOptions, Sample
 from thorvald_sim.simulation import Camera, save_png
@@ -29,8 +28,12 @@ class LabSession:
         self.label = label  # what the drive is, for the report's maps ("climb 14 deg")
         self.outcome = ""  # what came of it, set by the scenario ("ok", "traction", ...)
         self.shown: Optional[Mapping] = None  # the world the report draws, if not the physics' (plants)
+        # what the report draws beside the track, set by the scenario (JSON values): a turn's centre and
+        # circles, the plants a turn touched, which try of a series the drive was
+        self.marks: Dict[str, Any] = {}
         self.track: List[Pose] = []
         self.outline = self._outline()
+        self.centre_of_mass = self._centre_of_mass()
         self.on_close: Optional[Callable[[LabSession], None]] = None
 
     @property
@@ -99,6 +102,26 @@ class LabSession:
                 points.append((c * dx + s * dy, -s * dx + c * dy))
         return tuple(points)
 
+    def _centre_of_mass(self) -> Tuple[float, float, float]:
+        """[m] the simulated robot's centre of mass in base_link at the spawn pose: every body's mass
+        where pybullet holds it. Not always the description's: pybullet 3.2.7's merge of fixed links
+        (``URDF_MERGE_FIXED_LINKS``) puts each merged link's mass at the link's origin, not at its
+        inertial origin (3.9 cm higher than the description's on the example three-wheelers)."""
+        robot = self._session.robot
+        body, client = robot.body, robot.client
+        to_base_link = p.invertTransform(*robot.world_pose())
+        total, moment = 0.0, [0.0, 0.0, 0.0]
+        for link in range(-1, p.getNumJoints(body, physicsClientId=client)):
+            mass = p.getDynamicsInfo(body, link, physicsClientId=client)[0]
+            if link < 0:
+                where = p.getBasePositionAndOrientation(body, physicsClientId=client)[0]
+            else:
+                where = p.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=client)[0]
+            local = p.multiplyTransforms(*to_base_link, where, (0.0, 0.0, 0.0, 1.0))[0]
+            total += mass
+            moment = [m + mass * v for m, v in zip(moment, local)]
+        return tuple(m / total for m in moment) if total > 0.0 else (0.0, 0.0, 0.0)
+
     def picture(self, path: str, width: int = 480, height: int = 360) -> None:
         """A PNG of the robot where it stands, from its front left and above (pybullet's software renderer)."""
         (x, y, z), _ = self._session.robot.world_pose()
@@ -128,6 +151,7 @@ class Drive:
     outcome: str
     world: Mapping
     track: Tuple[Pose, ...]
+    marks: Mapping = field(default_factory=dict)  # the scenario's (LabSession.marks)
 
 
 class Lab:
@@ -142,6 +166,9 @@ class Lab:
         self.sessions = 0  # made so far: each a spawn in a world of its own
         self.drives: List[Drive] = []
         self.simulated = 0.0  # [s] of simulated time over every finished session
+        # [m] the simulated robot's centre of mass in base_link (LabSession.centre_of_mass), from the
+        # first session: what a scenario compares with its description's; None before any session
+        self.centre_of_mass: Optional[Tuple[float, float, float]] = None
 
     def session(
         self,
@@ -160,9 +187,11 @@ class Lab:
         )
         session = LabSession(self.robot_file, options, world, name=f"<scenario world {self.sessions}>", label=label)
         session.on_close = self._keep
+        if self.centre_of_mass is None:
+            self.centre_of_mass = session.centre_of_mass
         return session
 
     def _keep(self, session: LabSession) -> None:
         self.simulated += session.time
         world = session.shown if session.shown is not None else session.world
-        self.drives.append(Drive(session.label, session.outcome, world, tuple(session.track)))
+        self.drives.append(Drive(session.label, session.outcome, world, tuple(session.track), dict(session.marks)))

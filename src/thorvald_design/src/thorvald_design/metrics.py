@@ -159,7 +159,9 @@ def fit_circle(xs, ys) -> Tuple[float, float, float, float]:
 class TurningDiameters:
     """A steady turn's diameters [m] (ISO 789-3), its centre (X, Y) [m] in the world, the wheel contact
     that is outermost, whether it was a spin on the spot, and radius_spread [m]: the largest standard
-    deviation of any point's distance from the centre (0 in a steady turn; large: not steady)."""
+    deviation of any point's distance from the centre (0 in a steady turn; large: not steady);
+    outer_point (px, py) [m] in the body frame: the point whose circle is the clearance diameter's
+    (the outermost wheel's contact when nothing sticks out further)."""
 
     turning_diameter: float
     clearance_diameter: float
@@ -167,6 +169,7 @@ class TurningDiameters:
     outer_wheel: str
     spin: bool
     radius_spread: float
+    outer_point: Tuple[float, float] = (0.0, 0.0)
 
 
 def turning_diameters(
@@ -219,12 +222,39 @@ def turning_diameters(
         d = np.hypot(wx - centre[0], wy - centre[1])
         return float(np.mean(d)), float(np.std(d))
 
-    wheels = [(name, *radius(px, py)) for name, px, py in wheel_contacts]
-    others = [radius(px, py) for px, py in outline]
+    wheels = [(name, *radius(px, py), (float(px), float(py))) for name, px, py in wheel_contacts]
+    others = [(*radius(px, py), (float(px), float(py))) for px, py in outline]
     outer = max(wheels, key=lambda w: w[1])
     spread = max([w[2] for w in wheels] + [o[1] for o in others])
-    clearance = max([outer[1]] + [o[0] for o in others])
-    return TurningDiameters(2.0 * outer[1], 2.0 * clearance, centre, outer[0], spin, spread)
+    # the outermost point: the outer wheel's contact unless a point of the outline is further out
+    clearance, point = max([(outer[1], outer[3])] + [(o[0], o[2]) for o in others], key=lambda c: c[0])
+    return TurningDiameters(2.0 * outer[1], 2.0 * clearance, centre, outer[0], spin, spread, point)
+
+
+def convex_hull(points: Sequence[Tuple[float, float]]) -> Tuple[Tuple[float, float], ...]:
+    """The convex hull of plan points, counter-clockwise (Andrew's monotone chain; a point on an edge is
+    no corner); a box of two points for a diagonal's ends (an element whose footprint is a line)."""
+    pts = sorted(set((float(x), float(y)) for x, y in points))
+    if len(pts) == 2:
+        (x0, y0), (x1, y1) = pts
+        pts = sorted({(x0, y0), (x1, y0), (x1, y1), (x0, y1)})
+    if len(pts) < 3:
+        return tuple(pts)
+
+    def cross(o, a, b) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: list = []
+    upper: list = []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return tuple(lower[:-1] + upper[:-1])
 
 
 # --- drift -----------------------------------------------------------------------------------

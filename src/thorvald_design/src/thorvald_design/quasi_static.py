@@ -64,7 +64,17 @@ C_rr N_i each, which reads, with C_rr N_i added on both sides,
     sum_driven min((mu + C_rr) N_i, F_i) >= (what the task asks) + C_rr Nz
 
 the familiar sum with rolling resistance on every wheel, whose driven wheels' grip is mu + C_rr (the
-rolling resistance a driven wheel pays is its motor's, not its grip's). Braking (nose down) the
+rolling resistance a driven wheel pays is its motor's, not its grip's).
+
+The same torque has a moment about the ground-plane axes, which the statics above leave out unless
+asked (``rolling_offset``): a tyre's pressure lying ahead of its axle puts its load's line of action
+e = C_rr r ahead of the contact (the simulator's rolling friction, a torque of e N_i on each wheel,
+is the same moment), so a robot rolling forward has sum N_i (x_i + e) = My: its centre of pressure
+lies e further back than it would standing. Climbing, that is e less between the centre of pressure
+and the rear edge: tan(theta) = (d - e) / h at tipping, 1.2 degrees less for the rear-driven
+tricycle on grass (e = 12 mm, d = 138 mm, h = 0.5 m) than standing. The predictions a study reports
+are the standing figures (``rolling_offset`` 0); the design study's explanation of a gap between a
+simulated climb and its prediction gives the rolling one beside them. Braking (nose down) the
 torque helps the motor and not the grip: min((mu - C_rr) N_i, F_i) each against the slope's pull less
 C_rr Nz. Terramechanics' drawbar pull (thrust less motion resistance, both at the contact) is the
 other model, of a wheel sinking into soft soil; the simulator's wheels roll on springs and pay the
@@ -315,21 +325,32 @@ def _check_stands(layout: Layout) -> None:
         )
 
 
-def _tipping_slope(layout: Layout, ux: float, uy: float) -> float:
+def _tipping_slope(layout: Layout, ux: float, uy: float, rolling_offset: float = 0.0) -> float:
     """The slope at which the robot tips when its fall line points along u (in plan, base_link) [rad].
 
     On a slope alpha the centre of pressure moves h tan(alpha) downhill (the statics above), so it
-    reaches the edge when tan(alpha) = d / h, d the centre of mass's distance to the edge along u.
+    reaches the edge when tan(alpha) = d / h, d the centre of mass's distance to the edge along u;
+    rolling forward, d is measured from rolling_offset [m] behind the centre of mass (the module's
+    docstring). A robot whose centre of pressure is outside already tips at 0.
     """
-    d = _distance_to_edge(layout, layout.com[0], layout.com[1], ux, uy)
-    return math.atan2(d, layout.height)
+    d = _distance_to_edge(layout, layout.com[0] - rolling_offset, layout.com[1], ux, uy)
+    return math.atan2(max(d, 0.0), layout.height)
 
 
 # ---- loads -----------------------------------------------------------------------------------------
 def _resultants(
-    layout: Layout, pitch: float, roll: float, gravity: float, *, pull: float, pull_height: float
+    layout: Layout,
+    pitch: float,
+    roll: float,
+    gravity: float,
+    *,
+    pull: float,
+    pull_height: float,
+    rolling_offset: float = 0.0,
 ) -> Tuple[float, float, float]:
-    """(Nz, My, Mx) of the module's statics: the loads' sum, and their moments sum N x, sum N y."""
+    """(Nz, My, Mx) of the module's statics: the loads' sum, and their moments sum N x, sum N y; rolling
+    forward, each load's line of action rolling_offset [m] ahead of its contact (the module's
+    docstring), sum N x is rolling_offset Nz less."""
     for what, v in (("pitch", pitch), ("roll", roll)):
         if not (abs(v) <= math.pi / 2):
             raise ValueError(f"{what} {v} rad is not within +-pi/2")
@@ -337,10 +358,12 @@ def _resultants(
         raise ValueError(f"gravity must be finite and > 0, not {gravity}")
     if not (math.isfinite(pull) and math.isfinite(pull_height)):
         raise ValueError(f"the pull {pull} N at {pull_height} m is not finite")
+    if not (rolling_offset >= 0.0 and math.isfinite(rolling_offset)):
+        raise ValueError(f"rolling_offset must be finite and >= 0 m, not {rolling_offset}")
     w = layout.mass * gravity
     xc, yc, h = layout.com
     nz = w * math.cos(pitch) * math.cos(roll)
-    my = nz * xc - w * h * math.sin(pitch) - pull * pull_height
+    my = nz * (xc - rolling_offset) - w * h * math.sin(pitch) - pull * pull_height
     mx = nz * yc - w * h * math.cos(pitch) * math.sin(roll)
     return nz, my, mx
 
@@ -363,15 +386,18 @@ def normal_loads(
     *,
     pull: float = 0.0,
     pull_height: float = 0.0,
+    rolling_offset: float = 0.0,
 ) -> Tuple[float, ...]:
     """Each contact's normal load [N], in the layout's order, by the rigid-frame linear model.
 
     N_i = a + b x_i + c y_i with a, b, c from the three equilibrium equations of the module's
     docstring: with rows r_i = (1, x_i, y_i), sum r_i N_i = (Nz, My, Mx), so (sum r_i r_i^T) (a, b, c)
     = (Nz, My, Mx). Exact statics for three contacts. A load below 0 is reported as it is: that
-    wheel lifts (see :func:`contact_loads` for the loads once it has).
+    wheel lifts (see :func:`contact_loads` for the loads once it has). rolling_offset [m]: rolling
+    forward, each load's line of action that far ahead of its contact (the module's docstring).
     """
-    rows, f = _system(layout, _resultants(layout, pitch, roll, gravity, pull=pull, pull_height=pull_height))
+    f = _resultants(layout, pitch, roll, gravity, pull=pull, pull_height=pull_height, rolling_offset=rolling_offset)
+    rows, f = _system(layout, f)
     coefficients = np.linalg.solve(rows.T @ rows, f)
     return tuple(float(n) for n in rows @ coefficients)
 
@@ -415,6 +441,7 @@ def contact_loads(
     *,
     pull: float = 0.0,
     pull_height: float = 0.0,
+    rolling_offset: float = 0.0,
 ) -> Tuple[float, ...]:
     """Each contact's normal load [N] as the wheels carry it: all >= 0, a lifted wheel's 0.
 
@@ -422,7 +449,9 @@ def contact_loads(
     normal_loads while it has no load below 0. ValueError if the robot tips: the centre of pressure is
     not inside the support polygon, so no loads >= 0 balance it.
     """
-    nz, my, mx = _resultants(layout, pitch, roll, gravity, pull=pull, pull_height=pull_height)
+    nz, my, mx = _resultants(
+        layout, pitch, roll, gravity, pull=pull, pull_height=pull_height, rolling_offset=rolling_offset
+    )
     if nz <= 0.0 or min(_inside_distances(layout, my / nz, mx / nz)) <= 0.0:
         where = f"({my / nz:.3f}, {mx / nz:.3f})" if nz > 0.0 else "at infinity"
         raise ValueError(
@@ -563,7 +592,12 @@ class GradeLimits:
 
 
 def gradeability(
-    layout: Layout, friction: float, rolling_resistance: float = 0.0, gravity: float = GRAVITY
+    layout: Layout,
+    friction: float,
+    rolling_resistance: float = 0.0,
+    gravity: float = GRAVITY,
+    *,
+    rolling_offset: float = 0.0,
 ) -> GradeLimits:
     """The robot's grade limits (:class:`GradeLimits`) on a surface of friction mu and rolling
     resistance C_rr; ValueError if no wheel is driven or the robot cannot stand on level ground.
@@ -586,7 +620,9 @@ def gradeability(
         sum_driven min((mu - C_rr) N_i(-theta), F_i) >= W sin(theta) - C_rr W cos(theta)
 
     Each limit is the first theta where its condition fails, bracketed on a scan and bisected to
-    1e-6 rad.
+    1e-6 rad. rolling_offset [m]: the loads' lines of action that far ahead of their contacts, the
+    moment of the rolling resistance (the module's docstring; C_rr r for wheels of radius r; 0: the
+    standing figures).
     """
     _check_surface(friction, rolling_resistance, gravity)
     _check_driven(layout)
@@ -597,11 +633,13 @@ def gradeability(
     def climbing(theta: float) -> float:  # what the slope asks of the driven wheels [N]
         return w * (math.sin(theta) + c_rr * math.cos(theta))
 
-    def standing(pitch: float) -> Tuple[float, ...]:
-        return contact_loads(layout, pitch, gravity=gravity)
+    e = rolling_offset
 
-    tipping = _tipping_slope(layout, -1.0, 0.0)  # climbing, it tips backwards: u = -x
-    tipping_forward = _tipping_slope(layout, 1.0, 0.0)
+    def standing(pitch: float) -> Tuple[float, ...]:
+        return contact_loads(layout, pitch, gravity=gravity, rolling_offset=e)
+
+    tipping = _tipping_slope(layout, -1.0, 0.0, e)  # climbing, it tips backwards: u = -x
+    tipping_forward = _tipping_slope(layout, 1.0, 0.0, e)
 
     drive, brake = _driving(friction, c_rr), _braking(friction, c_rr)
     climb = _first_failure(lambda t: _effort(layout, standing(t), drive) >= climbing(t), tipping, ANGLE_TOLERANCE)
@@ -611,7 +649,7 @@ def gradeability(
         limited_by = _binding(layout, standing(climb), drive)
 
     def held_loads(theta: float) -> Tuple[float, ...]:  # past tipping: the robot held onto the slope
-        return standing(theta) if theta < tipping else normal_loads(layout, theta, gravity=gravity)
+        return standing(theta) if theta < tipping else normal_loads(layout, theta, gravity=gravity, rolling_offset=e)
 
     traction = _first_failure(
         lambda t: _effort(layout, held_loads(t), drive, torque=False) >= climbing(t), math.pi / 2, ANGLE_TOLERANCE
@@ -619,7 +657,9 @@ def gradeability(
     motors = sum(c.max_force for c in layout.driven)
     torque = _first_failure(lambda t: motors >= climbing(t), math.pi / 2, ANGLE_TOLERANCE)
 
-    lift = _first_failure(lambda t: min(normal_loads(layout, t, gravity=gravity)) > 0.0, tipping, ANGLE_TOLERANCE)
+    lift = _first_failure(
+        lambda t: min(normal_loads(layout, t, gravity=gravity, rolling_offset=e)) > 0.0, tipping, ANGLE_TOLERANCE
+    )
 
     descent = _first_failure(
         lambda t: _effort(layout, standing(-t), brake) >= w * (math.sin(t) - c_rr * math.cos(t)),
@@ -655,7 +695,13 @@ class PullLimit:
 
 
 def max_pull(
-    layout: Layout, friction: float, rolling_resistance: float, pull_height: float, gravity: float = GRAVITY
+    layout: Layout,
+    friction: float,
+    rolling_resistance: float,
+    pull_height: float,
+    gravity: float = GRAVITY,
+    *,
+    rolling_offset: float = 0.0,
 ) -> PullLimit:
     """The largest horizontal backward pull P at pull_height [m] that the driven wheels hold on level
     ground at constant speed: sum_driven min((mu + C_rr) N_i(P), F_i) >= P + C_rr W (every wheel
@@ -665,6 +711,7 @@ def max_pull(
     which helps rear drive and lifts the front; the robot tips backwards at P = W d / hp, d the
     distance from the centre of mass back to the support polygon's edge. sum min(...) is at most
     min((mu + C_rr) W, sum F_i), so the pull is too; the first failing pull is bracketed and bisected to 1e-6 N.
+    rolling_offset [m]: as :func:`gradeability`'s (the centre of pressure that much further back).
     ValueError if no wheel is driven, the robot cannot stand or pull_height < 0.
     """
     _check_surface(friction, rolling_resistance, gravity)
@@ -673,13 +720,14 @@ def max_pull(
     if not (pull_height >= 0.0 and math.isfinite(pull_height)):
         raise ValueError(f"pull_height must be finite and >= 0 m, not {pull_height}")
     w = layout.weight(gravity)
-    back = _distance_to_edge(layout, layout.com[0], layout.com[1], -1.0, 0.0)
+    e = rolling_offset
+    back = max(_distance_to_edge(layout, layout.com[0] - e, layout.com[1], -1.0, 0.0), 0.0)
     tipping = w * back / pull_height if pull_height > 0.0 else math.inf
     drive = _driving(friction, rolling_resistance)
     cap = min(drive * w, sum(c.max_force for c in layout.driven))
 
     def loads(pull: float) -> Tuple[float, ...]:
-        return contact_loads(layout, 0.0, gravity=gravity, pull=pull, pull_height=pull_height)
+        return contact_loads(layout, 0.0, gravity=gravity, pull=pull, pull_height=pull_height, rolling_offset=e)
 
     def holds(pull: float) -> bool:
         return _effort(layout, loads(pull), drive) >= pull + rolling_resistance * w

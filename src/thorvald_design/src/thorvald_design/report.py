@@ -2,12 +2,19 @@
 it shows in ``DIR/plots/``.
 
 What is on the page: the study's description; the results table (a column a candidate, a row a
-metric, as the terminal's table, with each candidate's status, the best value of a row in bold); a
-picture of each candidate (``DIR/pictures/<safe name>.png``, when the runs made one); a bar chart of
-each numeric metric across the candidates (a candidate without a value: a gap with its reason); for a
-sweep, each numeric metric against the swept value; the Pareto front of two metrics when asked for;
-each candidate's drives over a plan of the world they drove in (``DIR/tracks/<safe name>/<scenario>.json``,
-when the runs wrote them); and the study file as written.
+metric, as the terminal's table, with each candidate's status, the best value of a row in bold); the
+headland's turns, a row each (whether it works, its headland, the plants it touched, its time); each
+metric that has a quasi-static prediction drawn beside it on one chart (``compare_*.png``: the last
+try held, on to the first that failed, the prediction, and the prediction for the robot as simulated),
+with a sentence for each candidate whose two are more than the study's step apart saying why
+(:mod:`thorvald_design.report_views`); a picture of each candidate (``DIR/pictures/<safe name>.png``,
+when the runs made one); a bar chart of each other numeric metric across the candidates (a candidate
+without a value: a gap with its reason); for a sweep, each numeric metric against the swept value;
+the Pareto front of two metrics when asked for; each candidate's drives (``DIR/tracks/<safe
+name>/<scenario>.json``, when the runs wrote them), drawn as what they were: a turn with its ISO 789-3
+circles (the outermost wheel's path, the turning and clearance diameters), the headland's turns a
+colour each with the plants they touched ringed, a series of tries (ramps, steps, side slopes) from
+the side with how far each got, anything else over a plan of its world; and the study file as written.
 
 Why one page with everything in it (the plots as base64 data URIs, the CSS inline, no script but a
 counter of loaded images): a study's results are passed around as a file and opened on a laptop on a
@@ -15,8 +22,9 @@ farm, so nothing it needs may be elsewhere; the same inputs give the same bytes 
 random ids), so a report is compared and kept like any other result.
 
 Pure: what is plotted (:func:`metrics`, :func:`sweeps`, :func:`pareto_plane`: its front is
-:func:`thorvald_design.optimise.pareto_front`, the package's one), the plan of a world
-(:func:`world_map`) and the page (:func:`page_html`).
+:func:`thorvald_design.optimise.pareto_front`, the package's one; the comparisons, circles, side
+views and turns of :mod:`thorvald_design.report_views`), the plan of a world (:func:`world_map`) and
+the page (:func:`page_html`).
 Writing: the plots (matplotlib's Agg canvas, no pyplot) and the page (:func:`write_report`).
 """
 
@@ -27,10 +35,13 @@ import math
 import os
 import re
 import textwrap
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 import matplotlib
+import matplotlib.cm
+import matplotlib.colors
+import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
@@ -38,8 +49,26 @@ from matplotlib.patches import Circle, Polygon
 from thorvald_model.errors import ThorvaldModelError
 from thorvald_sim.world import element_kinds, parse_world, plant_positions
 
+from .metrics import convex_hull
 from .optimise import pareto_front
 from .report_table import _text, columns, rows
+from .report_views import (
+    Comparison,
+    SideTry,
+    TurnRow,
+    TurnView,
+    circle,
+    comparisons,
+    disagreement,
+    disagrees,
+    headland_rows,
+    side_series,
+    side_try,
+    try_text,
+    turn_colour_index,
+    turn_legend,
+    turn_view,
+)
 from .runs import safe_name
 from .scenarios import SCENARIOS
 from .study import Candidate, Study
@@ -246,6 +275,12 @@ class Drive:
     x: Tuple[float, ...]  # [m] world frame
     y: Tuple[float, ...]
     yaw: Tuple[float, ...] = ()  # [rad] as many as x, or none
+    t: Tuple[float, ...] = ()  # [s] as many as x, or none (each of these: an older file has none)
+    z: Tuple[float, ...] = ()  # [m] base_link's height
+    pitch: Tuple[float, ...] = ()  # [rad] nose up positive
+    roll: Tuple[float, ...] = ()  # [rad]
+    world: Mapping[str, Any] = field(default_factory=dict)  # its own world (a series' tries differ)
+    marks: Mapping[str, Any] = field(default_factory=dict)  # what the scenario said to draw beside it
 
 
 @dataclass(frozen=True)
@@ -257,8 +292,9 @@ class Tracks:
 
 
 def parse_tracks(data: Any) -> Tracks:
-    """A tracks file's contents (``{"world": {...}, "tracks": [{"label", "outcome", "t", "x", "y",
-    "yaw"}]}``); ValueError saying what is wrong."""
+    """A tracks file's contents (``{"world": {...}, "tracks": [{"label", "outcome", "world", "marks",
+    "t", "x", "y", "yaw", "z", "pitch", "roll"}]}``, all but x and y optional); ValueError saying what
+    is wrong."""
     if not isinstance(data, Mapping) or not isinstance(data.get("tracks"), list):
         raise ValueError("not a mapping with a list of tracks")
     drives = []
@@ -270,13 +306,20 @@ def parse_tracks(data: Any) -> Tracks:
             raise ValueError(f"track {k}: x and y must be lists of one length")
         if not all(number(v) is not None for v in xs + ys):
             raise ValueError(f"track {k}: x and y must be finite numbers")
-        yaw = track.get("yaw")
-        if yaw is not None and (
-            not isinstance(yaw, list) or len(yaw) != len(xs) or not all(number(v) is not None for v in yaw)
-        ):
-            raise ValueError(f"track {k}: yaw must be as many finite numbers as x")
+        more = {}
+        for key in ("yaw", "t", "z", "pitch", "roll"):
+            values = track.get(key)
+            if values is not None and (
+                not isinstance(values, list) or len(values) != len(xs) or not all(number(v) is not None for v in values)
+            ):
+                raise ValueError(f"track {k}: {key} must be as many finite numbers as x")
+            more[key] = tuple(values or ())
+        for key in ("world", "marks"):
+            if track.get(key) is not None and not isinstance(track.get(key), Mapping):
+                raise ValueError(f"track {k}: {key} must be a mapping")
+            more[key] = dict(track.get(key) or {})
         label, outcome = str(track.get("label", "")), str(track.get("outcome", ""))
-        drives.append(Drive(label, outcome, tuple(xs), tuple(ys), tuple(yaw or ())))
+        drives.append(Drive(label, outcome, tuple(xs), tuple(ys), **more))
     world = data.get("world")
     if not isinstance(world, Mapping) or not world:  # an older file: the first track's own world
         world = next((t["world"] for t in data["tracks"] if isinstance(t.get("world"), Mapping)), {})
@@ -306,31 +349,6 @@ def _rectangle(x: float, y: float, yaw: float, half_u: float, half_v: float) -> 
     c, s = math.cos(yaw), math.sin(yaw)
     corners = ((-half_u, -half_v), (half_u, -half_v), (half_u, half_v), (-half_u, half_v))
     return tuple((x + c * u - s * v, y + s * u + c * v) for u, v in corners)
-
-
-def convex_hull(points: Sequence[Point]) -> Tuple[Point, ...]:
-    """The convex hull, counter-clockwise (monotone chain); a box of two points for a diagonal's ends."""
-    pts = sorted(set((float(x), float(y)) for x, y in points))
-    if len(pts) == 2:
-        (x0, y0), (x1, y1) = pts
-        pts = sorted({(x0, y0), (x1, y0), (x1, y1), (x0, y1)})
-    if len(pts) < 3:
-        return tuple(pts)
-
-    def cross(o: Point, a: Point, b: Point) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower: List[Point] = []
-    upper: List[Point] = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return tuple(lower[:-1] + upper[:-1])
 
 
 def world_map(world: Any) -> WorldMap:
@@ -582,6 +600,284 @@ def plot_tracks(title: str, tracks: Tracks, plan: Optional[WorldMap], note: str,
     _save(fig, path)
 
 
+# ---- turning: ISO 789-3's circles -----------------------------------------------------------------------
+def _circle_label(ax: Any, centre: Point, diameter: float, *, angle: float, text: str, colour: str) -> None:
+    """text beside the circle of a diameter about centre, at angle [deg] from +x, away from the circle."""
+    a = math.radians(angle)
+    where = (centre[0] + 0.5 * diameter * math.cos(a), centre[1] + 0.5 * diameter * math.sin(a))
+    ha = "left" if math.cos(a) >= 0 else "right"
+    va = "bottom" if math.sin(a) >= 0 else "top"
+    offset = (3 * math.cos(a), 3 * math.sin(a))
+    ax.annotate(text, where, xytext=offset, textcoords="offset points", fontsize=7, color=colour, ha=ha, va=va)
+
+
+def plot_turning(title: str, tracks: Tracks, turns: Sequence[Optional[TurnView]], path: str) -> Figure:
+    """Each turn of a turning scenario in plan (ISO 789-3): the outermost wheel's path, the circle it
+    describes (the turning diameter), the circle of the robot's outermost point (the clearance
+    diameter), the turn's centre, base_link's path, and the robot's outline where the steady turn
+    began. A robot spinning on the spot has its base_link still and its wheels on a circle about it."""
+    # as high as a square map and the legend under it need (a line a turn and five for the line styles)
+    fig = _figure(6.4, 7.0 + 0.17 * (len(tracks.drives) + 5))
+    ax = fig.add_subplot()
+    xs: List[float] = []
+    ys: List[float] = []
+    for k, (drive, turn) in enumerate(zip(tracks.drives, turns)):
+        colour = SERIES[k % len(SERIES)]
+        ax.plot(drive.x, drive.y, "-", color=colour, linewidth=0.8, alpha=0.6)
+        xs += list(drive.x)
+        ys += list(drive.y)
+        if turn is None:
+            continue
+        r = 0.5 * turn.clearance_diameter
+        xs += [turn.centre[0] - r, turn.centre[0] + r]
+        ys += [turn.centre[1] - r, turn.centre[1] + r]
+        # the legend by turn: its outermost wheel and both diameters; the line styles' legend once
+        label = (f"{drive.label}: {turn.outer_wheel}'s path, turning diameter {turn.turning_diameter:.2f} m, "
+                 f"clearance diameter {turn.clearance_diameter:.2f} m")  # fmt: skip
+        ax.plot(*turn.wheel_path, "-", color=colour, linewidth=2.2, alpha=0.8, label=label)
+        ax.plot(*circle(turn.centre, turn.turning_diameter), "--", color=colour, linewidth=1.0)
+        ax.plot(*circle(turn.centre, turn.clearance_diameter), ":", color=colour, linewidth=1.4)
+        ax.plot([turn.centre[0]], [turn.centre[1]], "+", color=colour, markersize=10, markeredgewidth=1.5)
+        if k == 0:
+            if len(turn.outline) >= 3:
+                ax.add_patch(Polygon(turn.outline, closed=True, facecolor="#999999", alpha=0.25, edgecolor="#555555",
+                                     linewidth=0.8))  # fmt: skip
+            ax.plot(*turn.outer_point, "*", color="#333333", markersize=9)
+            for diameter, angle in ((turn.turning_diameter, -40.0), (turn.clearance_diameter, 40.0)):
+                _circle_label(ax, turn.centre, diameter, angle=angle, text=f"Ø {diameter:.2f} m", colour=colour)
+        ax.plot(*turn.outer_wheel_at, "o", color=colour, markersize=5, markeredgecolor="black", markeredgewidth=0.5)
+    grey = "#555555"
+    ax.plot([], [], "-", color=grey, linewidth=0.8, label="base_link's path")
+    ax.plot([], [], "--", color=grey, linewidth=1.0, label="the outermost wheel's circle (turning diameter)")
+    ax.plot([], [], ":", color=grey, linewidth=1.4, label="the outermost point's circle (clearance diameter)")
+    ax.plot([], [], "+", color=grey, markersize=9, linestyle="none", label="the turn's centre")
+    robot = "the robot where the steady turn began: its outermost wheel (dot) and point (star)"
+    ax.fill([], [], facecolor="#999999", alpha=0.25, edgecolor=grey, label=robot)
+    lo_x, hi_x = (min(xs), max(xs)) if xs else (-1.0, 1.0)
+    lo_y, hi_y = (min(ys), max(ys)) if ys else (-1.0, 1.0)
+    margin = max(0.3, 0.08 * max(hi_x - lo_x, hi_y - lo_y))
+    ax.set_xlim(lo_x - margin, hi_x + margin)
+    ax.set_ylim(lo_y - margin, hi_y + margin)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title)
+    fig.legend(fontsize=6.5, loc="outside lower center", ncol=1)
+    _save(fig, path)
+    return fig  # for a test to read what it draws
+
+
+# ---- the headland: a colour a turn, the plants it touched ---------------------------------------------
+TOUCHED = "#c00000"
+
+
+def plot_headland(title: str, tracks: Tracks, plan: Optional[WorldMap], note: str, path: str) -> Figure:
+    """The turns of a headland scenario over its rows, a colour each, the legend by turn (whether it
+    works, its headland, the plants it touched, its time) and a ring round each plant it touched."""
+    (x0, x1), (y0, y1) = view(tracks.drives, plan, reach=3.0)
+    turns = len(tracks.drives) + (1 if any(d.marks.get("touched") for d in tracks.drives) else 0)
+    fig = _figure(6.4, min(9.0, max(3.0, 1.2 + 5.6 * (y1 - y0) / (x1 - x0))) + 0.2 * turns)
+    ax = fig.add_subplot()
+    if plan is not None:
+        for shape in plan.shapes:
+            _draw_shape(ax, shape)
+        for plants, colour in plan.plants:
+            if plants:
+                ax.scatter([p[0] for p in plants], [p[1] for p in plants], s=5, color=colour[:3], linewidths=0)
+    ax.axvline(0.0, color="#777777", linewidth=0.8, linestyle="--")
+    ax.annotate("the rows' end", (0.0, 1.0), xycoords=("data", "axes fraction"), xytext=(3, -10),
+                textcoords="offset points", fontsize=7, color="#555555")  # fmt: skip
+    rings = 0
+    for drive in tracks.drives:
+        turn = str(drive.marks.get("turn") or drive.label)
+        colour = SERIES[turn_colour_index(turn) % len(SERIES)]
+        legend = turn_legend(drive.marks) if drive.marks.get("turn") else f"{drive.label}: {drive.outcome}"
+        ax.plot(drive.x, drive.y, "-", color=colour, linewidth=1.5, label=legend)
+        if drive.x:
+            works = drive.marks.get("works", drive.outcome == "ok")
+            ax.plot(drive.x[-1:], drive.y[-1:], "o" if works else "X", color=colour, markersize=5)
+        touched = [p for p in drive.marks.get("touched") or [] if isinstance(p, list) and len(p) == 2]
+        if touched:
+            ax.scatter([p[0] for p in touched], [p[1] for p in touched], s=55, facecolors="none", edgecolors=colour,
+                       linewidths=1.3, zorder=5)  # fmt: skip
+            rings += len(touched)
+    if rings:  # one legend entry for the rings, in no turn's colour
+        ax.scatter([], [], s=55, facecolors="none", edgecolors="#333333", linewidths=1.3,
+                   label="a plant touched (ringed in its turn's colour)")  # fmt: skip
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title)
+    if tracks.drives:
+        fig.legend(fontsize=7, loc="outside lower center", title="turn", title_fontsize=7)
+    if note:
+        _footnote(fig, note, "#444444")
+    _save(fig, path)
+    return fig  # for a test to read what it draws
+
+
+# ---- a series of tries, from the side -----------------------------------------------------------------
+SERIES_MAP = "viridis"
+
+
+SIDE_RATIO = 0.3  # a side view's height over its width, at least, where heights are exaggerated to get it
+MAX_EXAGGERATION = 20.0
+
+
+def side_exaggeration(width: float, height: float) -> float:
+    """How many times a side view draws heights larger than lengths: 1 where the view is at least
+    SIDE_RATIO as high as it is wide, else the least whole number (or half) that makes it so, at most
+    MAX_EXAGGERATION (a 2 cm step over 4 m)."""
+    if width <= 0.0 or height <= 0.0 or height >= SIDE_RATIO * width:
+        return 1.0
+    need = SIDE_RATIO * width / height
+    return min(MAX_EXAGGERATION, math.ceil(need * 2.0) / 2.0)
+
+
+def _side_extent(found: Sequence[SideTry]) -> Tuple[float, float, float, float, float]:
+    """(s from, s to, z from, z to, the heights' exaggeration) of a side view's panel."""
+    x_lo = min(float(np.min(t.ground[0])) for t in found)
+    x_hi = max(float(np.max(t.ground[0])) for t in found)
+    z_all = np.concatenate([np.concatenate([t.ground[1], t.path[1]]) for t in found])
+    z_lo, z_hi = float(np.min(z_all)), float(np.max(z_all))
+    pad = 0.08 * max(z_hi - z_lo, 0.05)
+    z_lo, z_hi = z_lo - pad, z_hi + 4.0 * pad  # room above for the legend
+    return x_lo, x_hi, z_lo, z_hi, side_exaggeration(x_hi - x_lo, z_hi - z_lo)
+
+
+LABEL_BOX = {"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.75}  # a label over lines
+SIDE_AXES_WIDTH = 4.9  # [in] of a side view's axes in its 6.4 in figure (the rest: labels, the colour bar)
+
+
+def plot_side(title: str, tries: Sequence[SideTry], note: str, path: str) -> Figure:
+    """A series' tries seen from the side (a panel a series: climbs and descents, steps up and down, a
+    side slope each way): the ground of each try's world along the drive (or across a hill's face for
+    a drive along its contour) and base_link's path over it, in a colour by the try's angle or height;
+    how each ended and how far it got beside the last held and every failed one. Each panel is as high
+    as its heights need at their exaggeration, so the panel fills its width."""
+    groups = side_series(tries)
+    extents = [_side_extent(found) for _, found in groups]
+    heights = [SIDE_AXES_WIDTH * (z1 - z0) * k / (x1 - x0) for x0, x1, z0, z1, k in extents]
+    fig = _figure(6.4, sum(h + 1.0 for h in heights) + (0.4 if note else 0.0))
+    grid = fig.add_gridspec(len(groups), 1, height_ratios=[h + 1.0 for h in heights])
+    cmap = matplotlib.colormaps[SERIES_MAP]
+    for g, (name, found) in enumerate(groups):
+        ax = fig.add_subplot(grid[g, 0])
+        x_lo, x_hi, z_lo, z_hi, exaggeration = extents[g]
+        values = [t.value for t in found]
+        lo, hi = min(values), max(values)
+        norm = matplotlib.colors.Normalize(vmin=lo, vmax=hi if hi > lo else lo + 1.0)
+        held = [t for t in found if t.ok]
+        labelled = {id(t) for t in found if not t.ok} | ({id(held[-1])} if held else set())
+        if len(found) <= 2:
+            labelled = {id(t) for t in found}
+        for one in found:
+            colour = cmap(0.9 * norm(one.value))  # not the palest yellow: it vanishes on white
+            ax.plot(*one.ground, "-", color=colour, linewidth=0.8, alpha=0.7)
+            s, z = one.path
+            ax.plot(s, z, "-", color=colour, linewidth=2.0)
+            end = int(np.argmax(s)) if one.section == "along" and not one.ok else len(s) - 1
+            ax.plot([s[end]], [z[end]], "o" if one.ok else "X", color=colour, markersize=6 if one.ok else 8,
+                    markeredgecolor="black" if not one.ok else colour, markeredgewidth=0.6)  # fmt: skip
+            if id(one) in labelled:
+                ink = colour if one.ok else "black"
+                ax.annotate(try_text(one), (s[end], z[end]), xytext=(5, 4 if one.ok else -12),
+                            textcoords="offset points", fontsize=7, color=ink, bbox=LABEL_BOX)  # fmt: skip
+        unit = found[0].unit
+        if hi > lo:  # a colour bar of the tries' values (one try: its label says it)
+            mappable = matplotlib.cm.ScalarMappable(norm=norm, cmap=matplotlib.colors.ListedColormap(
+                cmap(np.linspace(0.0, 0.9, 256))))  # fmt: skip
+            bar = fig.colorbar(mappable, ax=ax, pad=0.01, fraction=0.04)
+            bar.set_label("angle [deg]" if unit == "deg" else f"height [{unit}]", fontsize=7)
+            bar.ax.tick_params(labelsize=7)
+        ax.set_xlim(x_lo, x_hi)
+        ax.set_ylim(z_lo, z_hi)
+        ax.set_aspect(exaggeration, adjustable="box")
+        across = found[0].section == "across"
+        ax.set_xlabel("across the hill's face, up it [m] (0: its foot)" if across
+                      else "along the drive [m] (0: the hill's foot or the step's edge)")  # fmt: skip
+        ax.set_ylabel("height [m]" + ("" if exaggeration == 1.0 else f" (drawn x{exaggeration:g})"))
+        ax.set_title(f"{title}: {name}" if len(groups) > 1 else title, fontsize=9)
+        ax.plot([], [], "o", color="#555555", label="held")
+        ax.plot([], [], "X", color="#555555", markeredgecolor="black", label="failed")
+        ax.plot([], [], "-", color="#555555", linewidth=2.0, label="base_link's path")
+        ax.plot([], [], "-", color="#555555", linewidth=0.8, label="the ground of the try")
+        ax.legend(fontsize=6.5, loc="upper left", ncol=2)
+    if note:
+        _footnote(fig, note, "#444444")
+    _save(fig, path)
+    return fig  # for a test to read what it draws
+
+
+# ---- measured against predicted -----------------------------------------------------------------------
+MEASURED_LIGHT = "#a9c3dc"
+AS_SIMULATED = "#555555"
+
+
+def plot_comparison(comparison: Comparison, path: str) -> Figure:
+    """Each candidate's measured limit (the last try held, and on to the first that failed) and its
+    quasi-static prediction on one chart, with the prediction for the robot as simulated where the
+    results have it; a candidate whose two are more than the study's step apart is marked."""
+    rows = comparison.rows
+    fig = _figure(6.4, 1.6 + 0.42 * max(len(rows), 2))
+    ax = fig.add_subplot()
+    p = comparison.pairing
+    found = []
+    for row in rows:
+        found += [v for v in (number(row.measured), number(row.predicted), row.failed_at, row.with_com_and_rolling)
+                  if v is not None]  # fmt: skip
+    hi = max([*found, 0.0]) or 1.0
+    labelled = set()
+
+    def once(label: str) -> Optional[str]:
+        if label in labelled:
+            return None
+        labelled.add(label)
+        return label
+
+    names = []
+    for i, row in enumerate(rows):
+        bad = disagrees(comparison, row)
+        names.append(row.candidate + (" (!)" if bad else ""))
+        measured, predicted = number(row.measured), number(row.predicted)
+        if measured is None:
+            why = row.measured if row.measured is not None else row.predicted
+            ax.text(0.0, i, "  " + _short(why_not(why)), va="center", ha="left", color=GAP, style="italic", fontsize=8)
+        else:
+            ax.barh(i, measured, color=BAR, height=0.5, label=once("measured: the last try held"))
+            if row.failed_at is not None and row.failed_at > measured:
+                ax.barh(i, row.failed_at - measured, left=measured, color=MEASURED_LIGHT, height=0.5, hatch="///",
+                        edgecolor="white", linewidth=0.0, label=once("on to the first try that failed"))  # fmt: skip
+            # the measured value at the bar's root: its end is where the prediction's marker sits
+            inside = measured > 0.08 * hi
+            ax.text(0.0 if inside else measured, i, f" {_text(measured)} ", va="center", ha="left", fontsize=7,
+                    color="white" if inside else BAR)  # fmt: skip
+        if predicted is not None:
+            ax.plot([predicted], [i], "D", color=FRONT, markersize=7, markeredgecolor="black", markeredgewidth=0.5,
+                    label=once("predicted (quasi-static)"), zorder=5)  # fmt: skip
+            ax.annotate(f"{_text(predicted)}", (predicted, i), xytext=(6, -3), textcoords="offset points",
+                        fontsize=7, color=FRONT, bbox=LABEL_BOX)  # fmt: skip
+        if row.with_com_and_rolling is not None and predicted is not None and row.with_com_and_rolling != predicted:
+            ax.plot([row.with_com_and_rolling], [i], "D", markerfacecolor="none", markeredgecolor=AS_SIMULATED,
+                    markersize=7, label=once("predicted for the robot as simulated, rolling"), zorder=5)  # fmt: skip
+    ax.set_yticks(range(len(rows)), names)
+    for tick, row in zip(ax.get_yticklabels(), rows):
+        if disagrees(comparison, row):
+            tick.set_color(GAP)
+    ax.set_ylim(len(rows) - 0.5, -0.5)
+    ax.set_xlim(0.0, 1.18 * hi)
+    ax.grid(axis="y", visible=False)
+    ax.set_xlabel(f"{comparison.column} against {comparison.predicted_column} [{p.unit}]")
+    ax.set_title(f"{p.scenario}: {p.measured}{comparison.suffix}, measured and predicted")
+    if comparison.step is not None:
+        ax.plot([], [], " ", label=f"(!): more than the study's step ({_text(comparison.step)} {p.unit}) apart")
+    fig.legend(fontsize=7, loc="outside lower center", ncol=2)
+    _save(fig, path)
+    return fig  # for a test to read what it draws
+
+
 def _draw_shape(ax: Any, shape: Shape) -> None:
     colour = tuple(shape.colour[:3]) if shape.colour else "#888888"
     if shape.kind == "slope":
@@ -621,6 +917,10 @@ class Sections:
     pareto_text: str = ""
     tracks: Tuple[Tuple[str, Tuple[Image, ...]], ...] = ()  # (candidate, its scenarios' maps)
     notes: Tuple[str, ...] = ()  # what could not be shown, and why
+    # (chart, what the page says of each candidate whose measured limit and prediction disagree, a note
+    # when none does) of each measured metric with a quasi-static prediction
+    comparisons: Tuple[Tuple[Image, Tuple[str, ...], str], ...] = ()
+    turns: Tuple[TurnRow, ...] = ()  # the headland's turns, every candidate's
 
 
 CSS = """
@@ -652,6 +952,13 @@ figure img { max-width: 100%; height: auto; border: 1px solid #ddd; }
 figure.plot { width: calc(50% - 0.5em); min-width: 360px; }
 figure.picture { width: 340px; }
 figcaption { font-size: 0.85em; color: #444; }
+.compare { display: flex; flex-wrap: wrap; gap: 1em; align-items: flex-start; margin-bottom: 1em; }
+.compare figure.plot { flex: 0 1 54%; width: auto; min-width: 360px; }
+.compare .why { flex: 1 1 300px; font-size: 0.88em; }
+.compare .why li { margin-bottom: 0.5em; }
+p.disagree, li.disagree { color: #7a2410; }
+table.turns td.works { color: #17612a; }
+table.turns td.fails { color: #a03020; }
 pre { background: #f6f6f6; border: 1px solid #ddd; padding: 0.8em; overflow-x: auto; font-size: 0.85em; }
 @media print {
   body { max-width: none; padding: 0; }
@@ -742,6 +1049,26 @@ def table_html(results: Mapping[str, Any], study: Study) -> str:
     return "\n".join(lines)
 
 
+def turns_html(turns: Sequence[TurnRow]) -> str:
+    """The headland's turns, a row each: the candidate, the turn, whether it works, its headland, the
+    plants it touched and its time (results.json's ``headland.turns``); a turn not tried, why."""
+    head = "<tr><th>candidate</th><th>turn</th><th>works</th><th>headland [m] ↓</th><th>plants touched ↓</th>"
+    head += "<th>time [s]</th></tr>"
+    lines = [f'<table class="results turns"><thead>{head}</thead><tbody>']
+    for row in turns:
+        cells = [f'<th class="metric">{_e(row.candidate)}</th>', f'<td class="text">{_e(row.turn)}</td>']
+        if row.note:
+            cells.append(f'<td class="none" colspan="4">{_e(" ".join(row.note.split()))}</td>')
+        else:
+            works = "yes" if row.works else "no"
+            cells.append(f'<td class="{"works" if row.works else "fails"}">{works}</td>')
+            for value in (row.headland_m, row.plants_touched, row.time_s):
+                cells.append(_value_cell(value))
+        lines.append("<tr>" + "".join(cells) + "</tr>")
+    lines.append("</tbody></table>")
+    return "\n".join(lines)
+
+
 def _value_cell(value: Any, is_best: bool = False) -> str:
     """A number as the terminal's table shows it; words in full (the page has room for a reason)."""
     if number(value) is not None:
@@ -771,6 +1098,10 @@ def page_html(results: Mapping[str, Any], study: Study, sections: Sections) -> s
         f"{len(names)} candidates ({ok} ok), scenarios {_e(', '.join(s for s, _ in study.scenarios))}.</p>",
     ]
     contents = [("results", "Results")]
+    if sections.turns:
+        contents.append(("turns", "Headland turns"))
+    if sections.comparisons:
+        contents.append(("predicted", "Measured and predicted"))
     if sections.pictures:
         contents.append(("candidates", "Candidates"))
     if sections.metric_plots:
@@ -794,6 +1125,28 @@ def page_html(results: Mapping[str, Any], study: Study, sections: Sections) -> s
         + "</ul>"
     )
     parts.append(f'<div class="scroll">{table_html(results, study)}</div>')
+    if sections.turns:
+        parts.append('<h2 id="turns">Headland turns</h2>')
+        parts.append(
+            '<p class="note">Every turn each candidate tried out of a row and into the next: whether it ends in '
+            "the target row heading back along it, the headland it needs (the furthest any point of the robot "
+            "went beyond the rows' end), the plants its wheels (and its frame, for plants taller than its "
+            "clearance) touched, and how long it took. The narrowest that works touching the fewest plants is "
+            "the results' headland.</p>"
+        )
+        parts.append(f'<div class="scroll">{turns_html(sections.turns)}</div>')
+    if sections.comparisons:
+        parts.append('<h2 id="predicted">Measured and predicted</h2>')
+        parts.append(
+            '<p class="note">Each limit the simulation measures in steps beside the quasi-static limit its '
+            "weight distribution, grip and motors give. The measured value is the last try held: a prediction "
+            "the simulation bears out lies between it and the first try that failed, at most a step above it. "
+            "Where the two are more than the study's step apart, the page says so and why.</p>"
+        )
+        for image, sentences, note in sections.comparisons:
+            why = "".join(f'<li class="disagree">{_e(t)}</li>' for t in sentences)
+            text = f"<ul>{why}</ul>" if why else (f'<p class="note">{_e(note)}</p>' if note else "")
+            parts.append(f'<div class="compare">{_figure_html(image, "plot")}<div class="why">{text}</div></div>')
     if sections.pictures:
         parts.append('<h2 id="candidates">Candidates</h2>')
         parts.append(
@@ -817,9 +1170,13 @@ def page_html(results: Mapping[str, Any], study: Study, sections: Sections) -> s
     if sections.tracks:
         parts.append('<h2 id="tracks">Tracks</h2>')
         parts.append(
-            '<p class="note">Each drive of a scenario in plan view, over the map of the world in its tracks '
-            "file (the last drive's: the drives of a series may have had other worlds, e.g. steeper ramps on "
-            "the same footprint); shaded: hills (darker: their tops), dots: plants.</p>"
+            '<p class="note">Each scenario\'s drives as what they were. A turn (ISO 789-3): the outermost '
+            "wheel's path, the circle it describes (the turning diameter, dashed) and the circle of the robot's "
+            "outermost point (the clearance diameter, dotted), about the turn's centre. The headland: a colour "
+            "a turn, the plants each touched ringed. A series of tries (ramps, steps, side slopes): from the "
+            "side, each try's ground and base_link's path over it, coloured by the try's angle or height, with "
+            "how far the last held and every failed try got. Anything else in plan, over the map of the world "
+            "in its tracks file (shaded: hills, darker their tops; dots: plants).</p>"
         )
         for name, images in sections.tracks:
             parts.append(f"<h3>{_e(name)}</h3>")
@@ -846,11 +1203,24 @@ def write_report(out_dir: str, results: Mapping, study: Study, pareto: Optional[
     written: List[str] = []
     notes: List[str] = []
     with matplotlib.rc_context(RC):
+        compare_plots = []
+        compared = set()
+        for comparison in comparisons(results, study):
+            p = comparison.pairing  # a surface's column, and the headline that is the first surface's
+            compared |= {comparison.column, comparison.predicted_column, f"{p.scenario}.{p.measured}"}
+            compared |= {f"{p.scenario}.{p.predicted}"}
+            if not any(number(r.measured) is not None or number(r.predicted) is not None for r in comparison.rows):
+                continue
+            path = os.path.join(plots_dir, f"compare_{comparison.column}.png")
+            plot_comparison(comparison, path)
+            written.append(path)
+            caption = f"{comparison.column} (measured) and {comparison.predicted_column} (quasi-static)"
+            compare_plots.append((Plot(path, caption), *_comparison_text(comparison)))
         metric_plots = []
         by_column = {}
         for metric in metrics(results, study):
             by_column[metric.column] = metric
-            if not metric.numeric:
+            if not metric.numeric or metric.column in compared:  # drawn beside its prediction instead
                 continue
             path = os.path.join(plots_dir, f"metric_{metric.column}.png")
             plot_metric(metric, path)
@@ -907,6 +1277,8 @@ def write_report(out_dir: str, results: Mapping, study: Study, pareto: Optional[
         elif os.path.exists(path):
             notes.append(f"{name}: picture not shown: {os.path.relpath(path, out_dir)} is not a PNG")
     sections = Sections(
+        comparisons=tuple((_image(p), sentences, note) for p, sentences, note in compare_plots),
+        turns=tuple(headland_rows(results)) if any(s == "headland" for s, _ in study.scenarios) else (),
         pictures=tuple(pictures),
         metric_plots=tuple(_image(p) for p in metric_plots),
         sweep_plots=tuple(_image(p) for p in sweep_plots),
@@ -922,11 +1294,27 @@ def write_report(out_dir: str, results: Mapping, study: Study, pareto: Optional[
     return page
 
 
+def _comparison_text(comparison: Comparison) -> Tuple[Tuple[str, ...], str]:
+    """What the page says beside a comparison's chart: a sentence for each candidate whose measured value
+    and prediction disagree; where none does, a note that all are within the step."""
+    sentences = tuple(t for t in (disagreement(comparison, r) for r in comparison.rows) if t)
+    p = comparison.pairing
+    if sentences or comparison.step is None or not any(r.numbers for r in comparison.rows):
+        return sentences, ""
+    note = f"Every candidate's {p.measured}{comparison.suffix} is within the study's step "
+    note += f"({_text(comparison.step)} {p.unit}) of its prediction."
+    return sentences, note
+
+
 def _track_plot(title: str, out_dir: str, source: str, path: str) -> str:
     """Plots one tracks file (source, relative to out_dir); what went wrong ("" if nothing): a file that
     cannot be read is a note on the page, not the end of the report. A world that cannot be parsed:
     the tracks without a map. The page names files relative to DIR, so that it does not change with
-    DIR's place."""
+    DIR's place.
+
+    What the drives' marks say picks the plot: a turning scenario's turns (:func:`plot_turning`), a
+    headland's (:func:`plot_headland`), the tries of a series seen from the side (:func:`plot_side`);
+    anything else, or an older file without marks, the drives over the plan of the world."""
     try:
         with open(os.path.join(out_dir, source), encoding="utf-8") as f:
             tracks = parse_tracks(json.load(f))
@@ -940,11 +1328,43 @@ def _track_plot(title: str, out_dir: str, source: str, path: str) -> str:
             plan = world_map(parse_world(dict(tracks.world), source="the world"))
         except (ThorvaldModelError, ValueError, TypeError, KeyError) as e:
             note = "no map: " + _short(str(e).splitlines()[-1] if str(e) else type(e).__name__, 90)
+    turns = [turn_view(d) for d in tracks.drives]
+    if any(turns):
+        plot_turning(title, tracks, turns, path)
+        return ""
+    if any(d.marks.get("turn") for d in tracks.drives):
+        plot_headland(title, tracks, plan, note, path)
+        return ""
+    tries = _side_tries(tracks)
+    if tries:
+        plot_side(title, tries, "", path)
+        return ""
     plot_tracks(title, tracks, plan, note, path)
     return ""
 
 
-_OURS = re.compile(r"^(?:(?:metric|sweep|tracks)_.*|pareto)\.png$")
+def _side_tries(tracks: Tracks) -> List[SideTry]:
+    """The drives that are tries of a series, each over its own world (parsed once per world; a world
+    the parser refuses: the path alone, on flat ground)."""
+    worlds: Dict[str, Any] = {}
+    out = []
+    for drive in tracks.drives:
+        if not drive.marks.get("series"):
+            continue
+        data = dict(drive.world or tracks.world)
+        key = json.dumps(data, sort_keys=True)
+        if key not in worlds:
+            try:
+                worlds[key] = parse_world(data, source="the world") if data else None
+            except (ThorvaldModelError, ValueError, TypeError, KeyError):
+                worlds[key] = None
+        one = side_try(drive, worlds[key])
+        if one is not None:
+            out.append(one)
+    return out
+
+
+_OURS = re.compile(r"^(?:(?:metric|compare|sweep|tracks)_.*|pareto)\.png$")
 
 
 def _remove_stale(plots_dir: str, written: Sequence[str]) -> None:

@@ -125,7 +125,9 @@ TRACK_PERIOD = 0.1  # [s] between the poses a track file keeps
 
 
 def write_tracks(path: str, drives) -> None:
-    """The drives' tracks (world frame, a pose every TRACK_PERIOD) and worlds, for the report's maps."""
+    """The drives' tracks (world frame, a pose every TRACK_PERIOD: x, y, z [m], yaw, pitch, roll [rad]),
+    worlds and marks (what the scenario says the report should draw beside a track), for the report's
+    maps and side views."""
     tracks = []
     for drive in drives:
         kept, last = [], -math.inf
@@ -138,7 +140,8 @@ def write_tracks(path: str, drives) -> None:
                 "label": drive.label,
                 "outcome": drive.outcome,
                 "world": drive.world,
-                **{k: [round(getattr(q, k), 4) for q in kept] for k in ("t", "x", "y", "yaw")},
+                **{k: [round(getattr(q, k), 4) for q in kept] for k in ("t", "x", "y", "yaw", "z", "pitch", "roll")},
+                **({"marks": dict(drive.marks)} if getattr(drive, "marks", None) else {}),
             }
         )
     os.makedirs(os.path.dirname(path), exist_ok=True)

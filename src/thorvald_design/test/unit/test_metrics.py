@@ -167,6 +167,23 @@ def test_a_spin_about_a_point_off_the_origin_is_a_turn_about_that_point():
     assert result.clearance_diameter == pytest.approx(2 * math.hypot(LENGTH / 2 + 0.5, WIDTH / 2), abs=1e-6)
 
 
+def test_the_outermost_point_is_the_outlines_corner_or_else_the_outer_wheels_contact():
+    # about the body point (0.5, 0), the rear corners are the farthest: (-LENGTH/2, +-WIDTH/2)
+    yaw = np.linspace(0.0, 2 * math.pi, 300)
+    x, y = 2.0 - 0.5 * np.cos(yaw), -1.0 - 0.5 * np.sin(yaw)
+    result = turning_diameters(Track(np.linspace(0.0, 9.0, 300), x, y, yaw), WHEELS, OUTLINE)
+    assert result.outer_point[0] == pytest.approx(-LENGTH / 2) and abs(result.outer_point[1]) == pytest.approx(
+        WIDTH / 2
+    )
+    # an outline inside the wheels: the clearance circle is the outer wheel's, its point the contact
+    inside = [(0.5 * px, 0.5 * py) for px, py in OUTLINE]
+    spin = Track(np.linspace(0.0, 8.0, 200), np.full(200, 3.0), np.full(200, 4.0), np.linspace(0.0, 6.0, 200))
+    result = turning_diameters(spin, WHEELS, inside)
+    assert result.clearance_diameter == pytest.approx(result.turning_diameter)
+    wheel = next((px, py) for name, px, py in WHEELS if name == result.outer_wheel)
+    assert result.outer_point == pytest.approx(wheel)
+
+
 def test_a_straight_track_is_not_a_turn():
     with pytest.raises(ValueError, match="not a turn"):
         turning_diameters(straight_track(5.0, 0.3), WHEELS, OUTLINE)

@@ -224,6 +224,37 @@ def test_rolling_resistance_lowers_the_rear_drives_climb_as_its_closed_form_says
     assert gradeability(two_axle("fr"), mu, c_rr).descent == pytest.approx(math.atan(mu), abs=TOL)
 
 
+def test_rolling_the_loads_act_ahead_of_the_contacts_and_the_climb_tips_that_much_sooner():
+    # rolling forward, each load acts e ahead of its contact (the rolling resistance's moment): the
+    # centre of pressure lies e further back, so the rear axle carries W e / L more on level ground,
+    # and climbing, the robot tips where h tan(theta) = d - e (d: from the centre of mass back to the
+    # rear axle), not d
+    e, h = 0.03, 0.8
+    layout = two_axle("fr", h=h)
+    front, rear = axle_loads(layout, contact_loads(layout, 0.0, rolling_offset=e))
+    w = 200.0 * G
+    assert rear - front == pytest.approx(2 * w * e / 1.0)
+    assert front + rear == pytest.approx(w)
+    assert normal_loads(layout, 0.0, rolling_offset=e) == pytest.approx(contact_loads(layout, 0.0, rolling_offset=e))
+    standing, rolling = gradeability(layout, 0.9), gradeability(layout, 0.9, rolling_offset=e)
+    assert standing.tipping == pytest.approx(math.atan(0.5 / h), abs=TOL)
+    assert rolling.tipping == pytest.approx(math.atan((0.5 - e) / h), abs=TOL)
+    assert rolling.limited_by == TIPPING and rolling.climb == pytest.approx(rolling.tipping, abs=TOL)
+    # nose down it tips forwards, the centre of pressure that much further from the front axle
+    assert rolling.descent == pytest.approx(math.atan((0.5 + e) / h), abs=TOL)
+    # the pull tips the robot backwards at P hp = W (d - e)
+    tipped = max_pull(two_axle("fr"), 0.9, 0.0, pull_height=1.2, rolling_offset=e)
+    assert tipped.limited_by == TIPPING and tipped.pull == pytest.approx(w * (0.5 - e) / 1.2)
+    # the rear-driven tricycle's own: 12 mm of grass take its climb from 15.45 to 14.17 degrees
+    tricycle = load_layout(robot_file("thorvald_ii_1wd1ws_rwd"))
+    assert math.degrees(gradeability(tricycle, 0.55, 0.072).climb) == pytest.approx(15.45, abs=0.01)
+    assert math.degrees(gradeability(tricycle, 0.55, 0.072, rolling_offset=0.012).climb) == pytest.approx(
+        14.17, abs=0.01
+    )
+    with pytest.raises(ValueError, match="rolling_offset"):
+        contact_loads(layout, 0.0, rolling_offset=-0.01)
+
+
 def test_weak_motors_limit_the_climb_to_where_their_force_carries_the_slope():
     # W (sin + C cos) = sum F: sqrt(1 + C^2) sin(theta + atan C) = sum F / W
     c_rr, force = 0.03, 150.0

@@ -370,7 +370,8 @@ def test_write_report_writes_every_plot_and_one_page(made_report):
     assert page == str(out / "report.html")
     plots = sorted(os.listdir(out / "plots"))
     numeric = ["max_climb_deg", "max_descent_deg", "predicted_climb_deg", "predicted_descent_deg"]
-    expected = [f"metric_gradeability.{m}.png" for m in numeric]
+    # a measured limit and its prediction on one chart, not two
+    expected = ["compare_gradeability.max_climb_deg.png", "compare_gradeability.max_descent_deg.png"]
     expected += ["metric_turning.clearance_diameter_m.png", "metric_turning.turning_diameter_m.png"]
     expected += [f"sweep_wide_gradeability.{m}.png" for m in numeric]
     expected += ["sweep_wide_turning.clearance_diameter_m.png", "sweep_wide_turning.turning_diameter_m.png"]
@@ -396,6 +397,73 @@ def test_write_report_writes_every_plot_and_one_page(made_report):
     assert "<pre>" + "description: &quot;Wheel track" in text
     assert "On the front of gradeability.max_climb_deg (larger is better) and turning.turning_diameter_m" in text
     assert "wide[y=0.9]: turning: tracks not shown" in text
+    assert 'id="predicted"' in text and "apart, more than the study's step" not in text  # the study has no step
+
+
+HEADLAND_TURNS = {
+    "U": {"works": True, "headland_m": 1.95, "plants_touched": 0, "time_s": 20.7},
+    "omega": "n/a: a U turn fits: an omega turn would only be longer",
+    "spin": {"works": True, "headland_m": 1.88, "plants_touched": 10, "time_s": 26.7},
+}
+
+
+def disagreeing_study(step):
+    """A climb 3.45 degrees below its prediction (the drive-patterns study's tricycle) beside one 1.1
+    below, in a study whose ramps are step [deg] apart, and a headland's turns."""
+    study = Study(
+        source="/studies/tricycle.yaml", description="", seed=0,
+        candidates=(candidate("near"), candidate("tricycle")),
+        scenarios=(("gradeability", {"surface": "grass", "step_deg": step}), ("headland", {})),
+        text="",
+    )  # fmt: skip
+
+    def scenarios(climb, predicted, failed):
+        climbs = [[climb, "ok", "ok"], [failed, "tipping", "tipping"]]
+        grade_ = {**grade(climb, "tipping"), "predicted_climb_deg": predicted, "predicted_descent_deg": 20.5,
+                  "climbs": climbs, "descents": [[20.0, "ok"], [22.0, "ran away"]]}  # fmt: skip
+        headland = {"min_headland_m": 1.88, "turn": "spin", "plants_touched": 10, "turns": HEADLAND_TURNS}
+        return {"gradeability": grade_, "headland": headland}
+
+    results = {
+        "study": {"description": "", "seed": 0, "scenarios": ["gradeability", "headland"]},
+        "candidates": {
+            "near": entry("ok", scenarios(12.0, 13.1, 12.0 + step)),
+            "tricycle": entry("ok", scenarios(12.0, 15.45, 12.0 + step)),
+        },
+    }
+    return study, results
+
+
+def test_the_page_says_where_a_limit_and_its_prediction_disagree_beyond_the_step_and_not_otherwise(tmp_path):
+    study, results = disagreeing_study(2.0)
+    with open(write_report(str(tmp_path / "two"), results, study), encoding="utf-8") as f:
+        text = f.read()
+    plots = os.listdir(tmp_path / "two" / "plots")
+    assert "compare_gradeability.max_climb_deg.png" in plots
+    assert (
+        "metric_gradeability.max_climb_deg.png" not in plots
+        and "metric_gradeability.predicted_climb_deg.png" not in plots
+    )
+    section = text.split('<h2 id="predicted">')[1].split("<h2")[0]
+    assert section.count('<li class="disagree">') == 1  # the tricycle's, not near's (1.1 degrees apart)
+    assert "tricycle: climbed 12 deg (the 14 deg try: tipping), predicted 15.45 deg (traction): 3.45 deg apart, " \
+           "more than the study&#x27;s step of 2 deg." in section  # fmt: skip
+    assert "near: climbed" not in section
+    assert (
+        "Every candidate&#x27;s max_descent_deg is within the study&#x27;s step (2 deg) of its prediction." in section
+    )
+    # the same results in a study of 4 degree steps: within the step, no sentence
+    study, results = disagreeing_study(4.0)
+    with open(write_report(str(tmp_path / "four"), results, study), encoding="utf-8") as f:
+        text = f.read()
+    assert "apart, more than the study" not in text and '<li class="disagree">' not in text
+    assert "Every candidate&#x27;s max_climb_deg is within the study&#x27;s step (4 deg) of its prediction." in text
+    # the headland's turns, a row each, on the page
+    turns = text.split('<h2 id="turns">')[1].split("<h2")[0]
+    assert turns.split("<tbody>")[1].count("<tr>") == 6  # three turns of two candidates
+    assert '<td class="text">spin</td><td class="works">yes</td><td>1.88</td><td>10</td><td>26.7</td>' in turns
+    assert "n/a: a U turn fits: an omega turn would only be longer" in turns
+    assert '<a href="#turns">Headland turns</a>' in text and '<a href="#predicted">' in text
 
 
 @pytest.mark.slow  # two more reports
@@ -475,8 +543,22 @@ def test_report_of_a_real_study(tmp_path):
     pareto = ("gradeability.max_climb_deg", "turning.turning_diameter_m")
     page = write_report(str(out), results, study, pareto=pareto)
     plots = set(os.listdir(out / "plots"))
-    for column in ("gradeability.max_climb_deg", "turning.turning_diameter_m", "turning.clearance_diameter_m"):
+    for column in ("turning.turning_diameter_m", "turning.clearance_diameter_m"):
         assert f"metric_{column}.png" in plots and f"sweep_wide_{column}.png" in plots
+    assert "compare_gradeability.max_climb_deg.png" in plots and "sweep_wide_gradeability.max_climb_deg.png" in plots
+    # what the runs write for the report's turning plots and side views: each turn's centre, outermost
+    # wheel and diameters (the results' own), each try's series, heights and world
+    turning = json.loads((out / "tracks" / "std" / "turning.json").read_text())
+    ways = results["candidates"]["std"]["scenarios"]["turning"]["ways"]
+    for track_, way in zip(turning["tracks"], ways):
+        assert track_["marks"]["turning_diameter_m"] == way["turning_diameter_m"]
+        assert track_["marks"]["clearance_diameter_m"] == way["clearance_diameter_m"]
+        assert len(track_["marks"]["outline"]) >= 4 and track_["marks"]["outer_wheel"][0].startswith("drive")
+    climbs = json.loads((out / "tracks" / "std" / "gradeability.json").read_text())["tracks"]
+    assert [t["marks"]["value"] for t in climbs] == [c[0] for c in results["candidates"]["std"]["scenarios"][
+        "gradeability"]["climbs"]]  # fmt: skip
+    assert all(len(t["z"]) == len(t["x"]) and t["world"]["slopes"] for t in climbs)
+    assert "as_simulated" in results["candidates"]["std"]["scenarios"]["gradeability"]
     assert "pareto.png" in plots and not any("limited_by" in p or ".turn." in p for p in plots)
     # the runs' tracks, when they write them: a map of each
     for name in results["candidates"]:

@@ -16,15 +16,21 @@ which); with more than one surface, ``max_pull_n.KIND``, ``limited_by.KIND`` and
 What it must agree with: at constant speed on level ground the driven wheels' forces balance the
 pull and the rolling resistance: sum_driven min(mu N_i, F_i) = P + C_rr W, the loads N_i shifted
 rearwards by the pull's moment P h about the contacts
-(:func:`thorvald_design.quasi_static.max_pull`), reported as ``predicted_pull_n``.
+(:func:`thorvald_design.quasi_static.max_pull`), reported as ``predicted_pull_n``. Beside it,
+``as_simulated`` gives the same limit for the robot as the simulator holds it (its centre of mass,
+which pybullet's merge of fixed links may put higher than the description's) standing and rolling
+(each wheel's load the surface's rolling friction ahead of its contact), for the report to say what
+a gap between the pull and its prediction owes to them.
 """
 
 import math
 from typing import Any, Dict, List, Mapping, Tuple
 
 from thorvald_model.schema import Key
+from thorvald_sim.world.values import SURFACE_KINDS
 
-from .driving import SURFACE_RULE, SURFACES, flat_world, heading_hold, mean
+from ..quasi_static import max_pull
+from .driving import SURFACE_RULE, SURFACES, as_simulated, flat_world, heading_hold, mean, rolling_offset
 from .gradeability import TORQUE_BOUND
 from .kind import ScenarioKind
 
@@ -61,7 +67,32 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
     result = dict(pulls[kinds[0]])
     if len(kinds) > 1:
         result.update({f"{metric}.{kind}": pulls[kind][metric] for kind in kinds for metric in EACH})
+    result["as_simulated"] = as_simulated(design, lab, _limits(design, params))
     return result
+
+
+def _limits(design, params: Mapping[str, Any]):
+    """The predicted pulls of a layout, standing or rolling, under the results' keys (each surface's too)."""
+    kinds = params["surface"]
+
+    def limits(layout, rolling: bool) -> Dict[str, Any]:
+        out: Dict[str, Any] = {}
+        for k, kind in enumerate(kinds):
+            surface = SURFACE_KINDS[kind]
+            e = rolling_offset(kind) if rolling else 0.0
+            found = max_pull(
+                layout, surface.lateral_friction, design.rolling_resistance(kind), params["hitch_height"],
+                rolling_offset=e,
+            )  # fmt: skip
+            keys = ([""] if k == 0 else []) + ([f".{kind}"] if len(kinds) > 1 else [])
+            for suffix in keys:
+                out[f"predicted_pull_n{suffix}"] = round(found.pull, 1)
+                out[f"predicted_limited_by{suffix}"] = found.limited_by
+                if rolling:
+                    out[f"rolling_offset_m{suffix}"] = e
+        return out
+
+    return limits
 
 
 def _pull(lab, design, params: Mapping[str, Any], surface: str) -> Dict[str, Any]:

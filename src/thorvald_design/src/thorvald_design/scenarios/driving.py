@@ -4,6 +4,7 @@ rules that end a drive (reached, stalled, slid back, tipped).
 Pure: numbers and world-file contents (mappings), no simulator.
 """
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
@@ -15,6 +16,7 @@ from thorvald_model.layout import axle_lines
 from thorvald_sim.world.values import SURFACE_KINDS
 
 from ..metrics import Track
+from ..quasi_static import Layout
 from .kind import Pose
 
 SURFACES = tuple(SURFACE_KINDS)
@@ -162,3 +164,44 @@ def track_of(poses: Sequence[Pose]) -> Track:
 
 def mean(values: Sequence[float]) -> float:
     return sum(values) / len(values) if values else 0.0
+
+
+def rolling_offset(surface: str) -> float:
+    """[m] how far ahead of its contact a rolling wheel's load acts on a surface kind: the simulator's
+    rolling friction is a torque of this much times the load on every wheel (C_rr r for a tyre of
+    radius r: the surfaces' table gives it for Thorvald's 0.2 m wheels), the moment
+    :mod:`thorvald_design.quasi_static`'s ``rolling_offset`` takes."""
+    return SURFACE_KINDS[surface].rolling_friction
+
+
+def simulated_layout(design, lab) -> Optional[Layout]:
+    """The quasi-static layout of the robot as the simulator holds it: the description's mass and wheel
+    contacts, the centre of mass the physics has (``lab.centre_of_mass``, in base_link) above the
+    description's ground plane; None before the lab has made a session."""
+    com = getattr(lab, "centre_of_mass", None)
+    if com is None:
+        return None
+    ground = design.com[2] - design.layout.com[2]  # base_link's height of the description's ground plane
+    return dataclasses.replace(design.layout, com=(com[0], com[1], com[2] - ground))
+
+
+def as_simulated(design, lab, limits) -> Dict[str, Any]:
+    """What explains a gap between a simulated limit and its quasi-static prediction, for the report:
+    the centre of mass's height above the ground, the description's and the simulated robot's, and
+    ``limits(layout, rolling)`` (the scenario's predictions as a mapping of its result keys, for a
+    layout, rolling or standing) of the simulated robot standing (``with_com``) and rolling
+    (``with_com_and_rolling``). Empty before the lab has a session; a layout the model refuses (its
+    centre of mass outside its wheels) says so."""
+    layout = simulated_layout(design, lab)
+    if layout is None:
+        return {}
+    out: Dict[str, Any] = {
+        "com_height_m": round(design.layout.height, 4),
+        "simulated_com_height_m": round(layout.height, 4),
+    }
+    try:
+        out["with_com"] = limits(layout, False)
+        out["with_com_and_rolling"] = limits(layout, True)
+    except ValueError as e:
+        out["why_not"] = str(e)
+    return out

@@ -170,8 +170,11 @@ def _drive(lab, design, h: Headland, name: str) -> Dict[str, Any]:
             session.run(limit, command, lambda s: _tipped(s) or (s.track[-1].x < -IN_ROW and pursuit.done()))
         else:
             _phases(session, name, speed, out_x, target)
-        result = _measure(session.track[first:], session.outline, design, h, name)
+        result, touched = _measure(session.track[first:], session.outline, design, h, name)
         session.outcome = "ok" if result["works"] else "failed"
+        # what the report draws: the turn's figures and the plants it touched, where they stand
+        where = [[round(float(v), 4) for v in h.plants[i]] for i in touched]
+        session.marks = {"turn": name, **result, "touched": where}
     return result
 
 
@@ -222,7 +225,8 @@ def _tipped(session) -> bool:
     return max(abs(q.roll), abs(q.pitch)) > TIPPED
 
 
-def _measure(poses, outline, design, h: Headland, name: str) -> Dict[str, Any]:
+def _measure(poses, outline, design, h: Headland, name: str) -> Tuple[Dict[str, Any], Tuple[int, ...]]:
+    """The turn's figures, and the indices (into ``h.plants``) of the plants it touched."""
     params, target = h.params, h.target
     track = track_of(poses)
     end = poses[-1]
@@ -233,12 +237,13 @@ def _measure(poses, outline, design, h: Headland, name: str) -> Dict[str, Any]:
     reach = max(float(np.max(track.x + c * px - s * py)) for px, py in outline)
     footprints = _footprints(design, params, outline)
     touched = plants_touched(track, footprints, h.plants, params["plant_width"] / 2.0)
-    return {
+    figures = {
         "works": bool(works),
         "headland_m": round(max(reach, 0.0), 3),
         "plants_touched": int(touched.count),
         "time_s": round(poses[-1].t - poses[0].t, 2),
     }
+    return figures, touched.indices
 
 
 def _footprints(design, params, outline) -> List[Tuple[float, float, float, float]]:

@@ -35,6 +35,7 @@ class Session(Protocol):
     """One drive of a candidate in a world of the scenario's (see :class:`thorvald_design.lab.LabSession`)."""
 
     track: List[Pose]  # base_link at every control instant so far
+    marks: Dict[str, Any]  # what the report draws beside the track (JSON values), set by the scenario
 
     @property
     def time(self) -> float: ...
@@ -59,6 +60,10 @@ class Session(Protocol):
 
 
 class Lab(Protocol):
+    # [m] the simulated robot's centre of mass in base_link, known after the first session (the
+    # physics' own, which need not be the description's: see thorvald_design.lab.LabSession)
+    centre_of_mass: Optional[Tuple[float, float, float]]
+
     def session(
         self,
         world: Mapping,

@@ -83,6 +83,11 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
     return result
 
 
+def _try(series_name: str, height: float) -> Dict[str, Any]:
+    """The report's marks of one try: which series, its height; seen from the side along the drive."""
+    return {"series": series_name, "value": round(height, 6), "unit": "m", "section": "along"}
+
+
 def _up(lab, design, params, height: float) -> str:
     speed = params["speed"]
     length = 2.0 * design.length + 2.0
@@ -92,6 +97,7 @@ def _up(lab, design, params, height: float) -> str:
     limit = SETTLE + 2.0 * (goal - start_x) / speed + 10.0
     progress = Progress(slope=math.radians(5.0))
     with lab.session(world, x=start_x, label=f"up {height * 100:.0f} cm") as session:
+        session.marks = _try("up", height)
         session.run(SETTLE, lambda t: (0.0, 0.0, 0.0))
         z0 = session.track[-1].z
 
@@ -115,6 +121,7 @@ def _down(lab, design, params, height: float) -> str:
     limit = SETTLE + 2.0 * (goal - start_x) / speed + 10.0
     progress = Progress(slope=math.radians(5.0))
     with lab.session(world, x=start_x, z=height, label=f"down {height * 100:.0f} cm") as session:
+        session.marks = _try("down", height)
         session.run(SETTLE, lambda t: (0.0, 0.0, 0.0))
 
         def stop(s) -> bool:

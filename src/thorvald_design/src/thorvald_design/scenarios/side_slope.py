@@ -20,7 +20,10 @@ mass and the wheel contacts, not from the drive: the tilt about the support poly
 line through the downhill wheels' contacts) at which the vertical through the centre of mass passes
 over that edge, atan(d / h), d the horizontal distance from the centre of mass to the edge and h its
 height above the ground (:func:`thorvald_design.quasi_static.overturning_angles`); the smaller of the
-two sides. No robot should be driven near it: slip comes first on any real surface.
+two sides. No robot should be driven near it: slip comes first on any real surface. Beside it,
+``as_simulated`` gives the angle of the robot as the simulator holds it (its centre of mass, which
+pybullet's merge of fixed links may put higher than the description's), for the report to say what
+a traverse that tipped before the static angle owes to it.
 """
 
 import math
@@ -29,7 +32,8 @@ from typing import Any, Dict, Mapping
 from thorvald_model.schema import Key, one_of
 
 from ..metrics import lateral_drift
-from .driving import SURFACE_RULE, SURFACES, Progress, check_series, heading_hold, track_of
+from ..quasi_static import overturning_angles
+from .driving import SURFACE_RULE, SURFACES, Progress, as_simulated, check_series, heading_hold, track_of
 from .gradeability import SETTLE, angles
 from .kind import ScenarioKind
 
@@ -86,7 +90,13 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
         drift_per_m=_rounded(drift) if drift is not None else "n/a: no slope held",
         traverses=tries,
     )
+    result["as_simulated"] = as_simulated(design, lab, _limits)
     return result
+
+
+def _limits(layout, rolling: bool) -> Dict[str, Any]:
+    """The static overturning angle of a layout (standing: the same rolling or not)."""
+    return {"static_overturning_deg": _deg(overturning_angles(layout).lateral)}
 
 
 def _deg(angle: float) -> float:
@@ -112,6 +122,10 @@ def _traverse(lab, design, params, angle: float, way: float):
     limit = SETTLE + 2.0 * distance / speed + 10.0
     label = f"{math.degrees(angle):g} deg, {'left' if way > 0 else 'right'} side uphill"
     with lab.session(world, x=start_x, y=y, z=z, yaw=heading, roll=way * angle, label=label) as session:
+        session.marks = {
+            "series": f"{'left' if way > 0 else 'right'} side uphill", "value": round(math.degrees(angle), 6),
+            "unit": "deg", "section": "across", "distance_m": distance,
+        }  # fmt: skip
         session.run(SETTLE, lambda t: (0.0, 0.0, 0.0))
         first = len(session.track)
         command = heading_hold(session, heading, speed)

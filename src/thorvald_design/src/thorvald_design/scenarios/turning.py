@@ -34,7 +34,7 @@ from typing import Any, Dict, List, Mapping, Sequence, Tuple
 from thorvald_model.layout import axle_lines
 from thorvald_model.schema import Key, one_of
 
-from ..metrics import turning_diameters
+from ..metrics import convex_hull, turning_diameters
 from .driving import SURFACE_RULE, SURFACES, flat_world, track_of
 from .kind import ScenarioKind
 
@@ -106,10 +106,9 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
             start = len(session.track)
             session.run(params["settle"] + period, lambda t, twist=twist: twist)
             poses = session.track[start:]
-            outline = session.outline
+            found = turning_diameters(track_of(poses), contacts, session.outline)
             session.outcome = "ok"
-        track = track_of(poses)
-        found = turning_diameters(track, contacts, outline)
+            session.marks = _marks(found, contacts, session.outline, poses[0].t)
         ways.append(
             {
                 "way": "left" if way > 0 else "right",
@@ -121,6 +120,22 @@ def procedure(lab, design, params: Mapping[str, Any]) -> Dict[str, Any]:
     result["clearance_diameter_m"] = max(w["clearance_diameter_m"] for w in ways)
     result["ways"] = ways
     return result
+
+
+def _marks(found, contacts, outline, steady_from: float) -> Dict[str, Any]:
+    """What the report draws of one turn: its centre in the world, the outermost wheel (its name and
+    contact in base_link), the outermost point, both diameters, the robot's outline (its convex hull
+    in base_link) and when the steady turn began [s]."""
+    outer = next((x, y) for name, x, y in contacts if name == found.outer_wheel)
+    return {
+        "centre": [round(v, 4) for v in found.centre],
+        "outer_wheel": [found.outer_wheel, *(round(v, 4) for v in outer)],
+        "outer_point": [round(v, 4) for v in found.outer_point],
+        "turning_diameter_m": round(found.turning_diameter, 3),
+        "clearance_diameter_m": round(found.clearance_diameter, 3),
+        "outline": [[round(x, 4), round(y, 4)] for x, y in convex_hull(outline)],
+        "steady_from_s": round(steady_from, 3),
+    }
 
 
 TURNING = ScenarioKind(
