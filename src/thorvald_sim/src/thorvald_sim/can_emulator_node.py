@@ -102,6 +102,9 @@ class EmulatorNode:
                     if now >= when:
                         self.hub.restore(k)
                         del self.reopen_at[k]
+        e = self.emulator
+        # what the bus carried, said once at the end: a soak beside busy loops reads it (bench/can_soak.py)
+        print(f"can_emulator: {self.hub.summary()}; devices: {e.received} frames in, {e.sent} out", flush=True)
         self.hub.close()
 
 

@@ -65,6 +65,8 @@ class SlcanPort:
         self.channel_open = False  # SLCAN "O" .. "C": frames flow only while the channel is open
         self.malformed = 0
         self.dropped = 0  # frames dropped for a participant that does not read
+        self.received = 0  # frames the participant wrote
+        self.forwarded = 0  # frames given to the participant (written, or waiting for room)
         self.open()
 
     @property
@@ -124,6 +126,7 @@ class SlcanPort:
                 continue
             if msg is not None:
                 self.bus.send(msg)
+                self.received += 1
                 continue
             command = line[:1]
             if command == b"O":  # the channel opens: what an earlier participant left unread is stale
@@ -159,6 +162,7 @@ class SlcanPort:
                 self.dropped += 1
             else:
                 self.pending += frame
+                self.forwarded += 1
         if self.pending:
             self.pending = self.pending[self._write(self.pending) :]
 
@@ -210,6 +214,13 @@ class Hub:
                         p.from_terminal()
             for p in open_ports:
                 p.to_terminal()
+
+    def summary(self) -> str:
+        """What each port carried and lost, in one line."""
+        return "; ".join(
+            f"port{k}: {p.received} frames in, {p.forwarded} out, {p.malformed} malformed, {p.dropped} dropped"
+            for k, p in enumerate(self.ports)
+        )
 
     def close(self) -> None:
         with self.lock:

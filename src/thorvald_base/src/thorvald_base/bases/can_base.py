@@ -34,7 +34,7 @@ RELAY_QUEUE_LIMIT = 100  # frames relayed per cycle; the original dropped its qu
 READ_LIMIT = 2000  # frames read per cycle at most (a flooded bus cannot stall the loop)
 REOPEN_PERIOD = 1.0  # [s] of wall time between attempts to reopen a failed bus
 # [s] of wall time a write may wait for room in a full buffer; what does not fit waits in the outbox
-# for the next poll (half a cycle), so a slow reader never holds base_driver's loop
+# for the next poll (base_driver polls two or three times a cycle), so a slow reader never holds its loop
 WRITE_WAIT = 0.002
 CLOSE_WAIT = 0.1  # [s] closing, for the last frames (the wheels' stop) to fit
 
@@ -259,6 +259,7 @@ class CanBase(BaseHandle):
         self.muted = muted
         if muted:
             self.relay_queue.clear()
+            self.outbox.discard(lambda f: f.relayed)  # those a refused write left: muted means none go
         return "extra CAN device commands " + ("muted" if muted else "unmuted")
 
     def take_received(self) -> Tuple[List[Frame], List[Frame]]:
@@ -269,17 +270,13 @@ class CanBase(BaseHandle):
 
     def _send_relayed(self):
         for f in self.relay_queue:  # never replaced: an implement's protocol may count every frame
-            self.outbox.put(Waiting(f.id, f.data, f.is_extended, f.is_remote, self._now))
+            self.outbox.put(Waiting(f.id, f.data, f.is_extended, f.is_remote, self._now, relayed=True))
         self.relay_queue.clear()
         self._flush()
 
     # ---- bus I/O -----------------------------------------------------------------------------
     def _send_all(self, frames: Sequence[Tuple[int, bytes]]) -> None:
         self._queue(frames)
-        self._flush()
-
-    def _send(self, can_id: int, data: bytes, extended: bool = False, remote: bool = False) -> None:
-        self.outbox.put(Waiting(can_id, data, extended, remote, self._now))
         self._flush()
 
     def _queue(self, frames: Sequence[Tuple[int, bytes]]) -> None:
@@ -311,9 +308,10 @@ class CanBase(BaseHandle):
         batch = getattr(self.bus, "send_batch", None)  # one write for all (BufferedSlcanBus)
         if batch is not None:
             try:
-                return batch(messages, timeout=wait), None
+                sent = batch(messages, timeout=wait)
             except Exception as e:  # the interface's own errors, whatever their class
                 return 0, e
+            return (len(messages) if sent is None else sent), None  # None: a batch that says nothing sent all
         for k, msg in enumerate(messages):
             try:
                 self.bus.send(msg, timeout=wait)
@@ -325,7 +323,7 @@ class CanBase(BaseHandle):
         self._now = time
         if self.bus is None and not self._try_reopen():
             return
-        if len(self.outbox):  # what a refused write left: retried at every poll, twice a cycle
+        if len(self.outbox):  # what a refused write left: retried at every poll
             self._flush()
             if self.bus is None:
                 return
@@ -357,7 +355,7 @@ class CanBase(BaseHandle):
             self.counters.send_errors += 1
         else:
             self.counters.receive_errors += 1
-        self.counters.last_error = f"{what}: {type(error).__name__}: {error}"
+        self.counters.last_error = f"{what}: {_reason(error)}"
         if self._reopen is not None:
             try:
                 self.bus.shutdown()
