@@ -104,9 +104,10 @@ class LabSession:
 
     def _centre_of_mass(self) -> Tuple[float, float, float]:
         """[m] the simulated robot's centre of mass in base_link at the spawn pose: every body's mass
-        where pybullet holds it. Not always the description's: pybullet 3.2.7's merge of fixed links
-        (``URDF_MERGE_FIXED_LINKS``) puts each merged link's mass at the link's origin, not at its
-        inertial origin (3.9 cm higher than the description's on the example three-wheelers)."""
+        where pybullet holds it: the description's, since the simulator loads each merged link's mass
+        at its centre (thorvald_sim.description.centre_fixed_links); measured, so that a fault of the
+        loading would show beside the prediction, as pybullet's merge of fixed links did (3.9 cm
+        higher on the example three-wheelers)."""
         robot = self._session.robot
         body, client = robot.body, robot.client
         to_base_link = p.invertTransform(*robot.world_pose())

@@ -10,9 +10,9 @@ A series measures a limit in steps (ramps every ``step_deg``, pulls every ``step
 reports is the last try held, so a limit the prediction has right lies between it and the first try
 that failed, at most a step above it. The page says a measured limit and its prediction disagree
 where they are more than the study's step apart, and why: what the results carry of the simulated
-robot (``as_simulated``: its centre of mass, which pybullet's merge of fixed links may hold higher
-than the description's, and the predictions with it, standing and rolling) and what the scenario's
-meaning says of the rest.
+robot (``as_simulated``: its centre of mass, measured in the simulator, should a fault of its loading
+move it from the description's, and the predictions with it, standing and rolling) and what the
+scenario's meaning says of the rest.
 """
 
 import math
@@ -226,8 +226,8 @@ def disagreement(comparison: Comparison, row: Compared) -> str:
             reasons.append(
                 f"the simulated robot's centre of mass is {row.simulated_com_height:.3f} m above the ground, "
                 f"{abs(dz) * 100:.1f} cm {'above' if dz > 0 else 'below'} its description's {row.com_height:.3f} m "
-                f"(pybullet's merge of the frame's fixed links puts each link's mass at the link's origin, not its "
-                f"inertial origin): with it the prediction is {_value(row.with_com, unit)}"
+                f"(the simulator holds a link's mass elsewhere than its description does): with it the prediction "
+                f"is {_value(row.with_com, unit)}"
             )
         standing = row.with_com
     rolling = row.with_com_and_rolling

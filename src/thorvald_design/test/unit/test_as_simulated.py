@@ -1,7 +1,6 @@
 """What a study records to explain a gap between a simulated limit and its prediction, and what the
-report draws from: the simulated robot's centre of mass (pybullet's, which its merge of fixed links
-holds higher than the description's), the predictions of the robot as simulated, standing and
-rolling, and the tracks files' heights and marks."""
+report draws from: the simulated robot's centre of mass (measured in the simulator), the predictions
+of the robot as simulated, standing and rolling, and the tracks files' heights and marks."""
 
 import json
 import math
@@ -16,9 +15,7 @@ from thorvald_design.runs import write_tracks
 from thorvald_design.scenarios.driving import as_simulated, rolling_offset, simulated_layout
 from thorvald_design.scenarios.gradeability import _limits
 from thorvald_design.scenarios.kind import Pose
-from thorvald_model.description import generate_urdf, package_file
-from thorvald_model.joint_tree import JointTree
-from thorvald_model.mass_properties import link_poses, mass_properties
+from thorvald_model.description import package_file
 
 TRICYCLE = "thorvald_ii_1wd1ws_rwd"
 
@@ -28,34 +25,9 @@ def tricycle():
     return design_of(TRICYCLE, package_file("config", TRICYCLE, TRICYCLE + ".yaml"))
 
 
-def merged_centre_of_mass(urdf):
-    """The centre of mass pybullet 3.2.7 holds a description at when it merges fixed links: a link joined
-    to base_link by fixed joints only has its mass at its own origin (its inertial origin ignored, the
-    base's too); a link behind a moving joint, at its inertial origin."""
-    import xml.etree.ElementTree as ET  # noqa: PLC0415
-
-    tree = JointTree(urdf)
-    robot = ET.fromstring(urdf)
-    _, poses = link_poses(tree, [link.get("name") for link in robot.findall("link")])
-    moving = set()
-    for link in tree.tree:  # a link is moving when any joint on its way to the root moves
-        name = link
-        while name in tree.tree:
-            if tree.moving(tree.tree[name].joint):
-                moving.add(link)
-            name = tree.tree[name].parent
-    props = mass_properties(urdf)
-    total, moment = 0.0, [0.0, 0.0, 0.0]
-    for name, mass, com in props.links:
-        where = com if name in moving else poses[name][0]
-        total += mass
-        moment = [m + mass * v for m, v in zip(moment, where)]
-    return tuple(m / total for m in moment), moving
-
-
-def test_the_simulated_robots_centre_of_mass_is_where_pybullets_merge_puts_it(tricycle):
-    """The cause of most of the tricycle's early tip, measured: 3.9 cm higher than its description's.
-    (If the simulator ever loads robots without this fault, this test says the docs' sizes are stale.)"""
+def test_the_simulated_robots_centre_of_mass_is_the_descriptions(tricycle):
+    """Measured in the simulator: where the description has it (pybullet's merge of fixed links put it
+    3.9 cm higher until the simulator loaded each merged link's mass at its centre)."""
     from thorvald_design.lab import Lab  # noqa: PLC0415 (pybullet)
 
     lab = Lab(tricycle.robot_file)
@@ -63,11 +35,7 @@ def test_the_simulated_robots_centre_of_mass_is_where_pybullets_merge_puts_it(tr
     with lab.session({"ground": {"surface": "tarmac"}}) as session:
         found = session.centre_of_mass
     assert lab.centre_of_mass == found
-    assert found[:2] == pytest.approx(tricycle.com[:2], abs=1e-4)  # in plan the description's
-    assert found[2] - tricycle.com[2] == pytest.approx(0.0393, abs=5e-4)  # higher
-    urdf = generate_urdf(tricycle.robot_file, tf_prefix="")
-    expected, _ = merged_centre_of_mass(urdf)
-    assert found == pytest.approx(expected, abs=5e-4)
+    assert found == pytest.approx(tricycle.com, abs=1e-4)
 
 
 def test_the_predictions_of_the_robot_as_simulated(tricycle):

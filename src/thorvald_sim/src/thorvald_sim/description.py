@@ -11,6 +11,7 @@ wheels) with their friction. A URDF without the block (any other robot) is a pas
 """
 
 import copy
+import math
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -19,7 +20,15 @@ from typing import Callable, Dict, Iterable, List, Mapping, Optional, Tuple
 
 from thorvald_model.datum import Datum, parse_datum
 from thorvald_model.errors import ConfigError
-from thorvald_model.joint_tree import Origin, ParentJoint, UrdfError  # noqa: F401  (Origin: for the sensors)
+from thorvald_model.joint_tree import (  # noqa: F401  (Origin: for the sensors)
+    IDENTITY_TRANSFORM,
+    Origin,
+    ParentJoint,
+    UrdfError,
+    compose,
+    quaternion_from_rpy,
+    rotate,
+)
 from thorvald_model.joint_tree import link_tree as _link_tree
 from thorvald_model.keys import DRIVE_KEYS
 from thorvald_model.motors import PROPULSION_KEYS, STEERING_KEYS, Motor, propulsion_motor, steering_motor
@@ -254,6 +263,99 @@ def narrow_tyres(root: ET.Element, wheel_joints: Iterable[str], width: float) ->
             continue
         for cylinder in tyre_cylinders(link):
             cylinder.set("length", repr(min(float(cylinder.get("length")), width)))
+
+
+ROOT_MASS = 1e-6  # [kg] the root link keeps (pybullet makes a body of mass 0 static)
+ROOT_CENTRE = "{}__centre_of_mass"  # the link that carries the root link's own mass
+
+
+def centre_fixed_links(root: ET.Element) -> None:
+    """Moves the frame of every link joined by a fixed joint to its centre of mass, in place, the
+    robot unchanged: its joint's origin, its visuals', collisions' and inertial origins and its child
+    joints' origins are composed to match. The root link's own mass moves to a link of its own
+    (ROOT_CENTRE) fixed at its centre of mass; the root keeps ROOT_MASS.
+
+    pybullet 3.2.7 merging fixed links (``URDF_MERGE_FIXED_LINKS``, the simulator's: 8 bodies of the
+    standard robot instead of 34) puts each merged link's mass at the link's origin, not at its
+    inertial origin, the root's included: a battery whose frame is its mounting point 10 cm above its
+    middle, base_link's kilogram at the ground; the standard robot's centre of mass 1.4 cm high, the
+    tricycle's 3.9 cm (a design study tipped it 1.1 degrees early). With every merged link's frame at
+    its centre of mass, the merge puts each mass where the description does."""
+    _root_mass_apart(root)
+    joints = root.findall("joint")
+    by_child = {j.find("child").get("link"): j for j in joints if j.find("child") is not None}
+    for link in root.findall("link"):
+        joint = by_child.get(link.get("name"))
+        inertial = link.find("inertial")
+        if joint is None or joint.get("type") != "fixed" or inertial is None:
+            continue
+        centre = _origin(inertial)
+        if centre == IDENTITY_TRANSFORM:
+            continue
+        back = _inverse(centre)
+        _set_origin(joint, compose(_origin(joint), centre))
+        _set_origin(inertial, IDENTITY_TRANSFORM)
+        for element in (*link.findall("visual"), *link.findall("collision")):
+            _set_origin(element, compose(back, _origin(element)))
+        for child_joint in joints:
+            parent = child_joint.find("parent")
+            if parent is not None and parent.get("link") == link.get("name"):
+                _set_origin(child_joint, compose(back, _origin(child_joint)))
+
+
+def _root_mass_apart(root: ET.Element) -> None:
+    children = {j.find("child").get("link") for j in root.findall("joint") if j.find("child") is not None}
+    roots = [link for link in root.findall("link") if link.get("name") not in children]
+    if len(roots) != 1:
+        return
+    base = roots[0]
+    inertial = base.find("inertial")
+    if inertial is None or _origin(inertial) == IDENTITY_TRANSFORM:
+        return
+    name = ROOT_CENTRE.format(base.get("name"))
+    base.remove(inertial)
+    ET.SubElement(root, "link", name=name).append(inertial)
+    joint = ET.SubElement(root, "joint", name=name + "_joint", type="fixed")
+    ET.SubElement(joint, "parent", link=base.get("name"))
+    ET.SubElement(joint, "child", link=name)
+    kept = ET.SubElement(base, "inertial")
+    ET.SubElement(kept, "mass", value=repr(ROOT_MASS))
+    ET.SubElement(kept, "inertia", ixx="1e-9", iyy="1e-9", izz="1e-9", ixy="0", ixz="0", iyz="0")
+
+
+def _origin(element: ET.Element):
+    """The transform of an element's <origin> (identity without one)."""
+    origin = element.find("origin")
+    if origin is None:
+        return IDENTITY_TRANSFORM
+    xyz = tuple(float(v) for v in (origin.get("xyz") or "0 0 0").split())
+    rpy = tuple(float(v) for v in (origin.get("rpy") or "0 0 0").split())
+    return xyz, quaternion_from_rpy(*rpy)
+
+
+def _set_origin(element: ET.Element, transform) -> None:
+    origin = element.find("origin")
+    if origin is None:
+        origin = ET.SubElement(element, "origin")
+    xyz, q = transform
+    origin.set("xyz", " ".join(repr(v) for v in xyz))
+    origin.set("rpy", " ".join(repr(v) for v in rpy_from_quaternion(q)))
+
+
+def _inverse(transform):
+    xyz, (x, y, z, w) = transform
+    conjugate = (-x, -y, -z, w)
+    back = rotate(conjugate, xyz)
+    return (-back[0], -back[1], -back[2]), conjugate
+
+
+def rpy_from_quaternion(q) -> Tuple[float, float, float]:
+    """URDF's roll, pitch, yaw [rad] (about fixed x, y, z) of a unit quaternion (x, y, z, w)."""
+    x, y, z, w = q
+    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return roll, pitch, yaw
 
 
 def with_wheel_radii(xml: str, radii: Mapping[str, float]) -> str:

@@ -47,10 +47,9 @@ from .bullet import quiet_stdout
 from .description import (
     DescriptionError,
     RobotDescription,
+    centre_fixed_links,
     narrow_tyres,
     set_wheel_radii,
-    with_tyre_contact,
-    with_wheel_radii,
 )
 
 LOAD_FLAGS = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_USE_IMPLICIT_CYLINDER | p.URDF_MERGE_FIXED_LINKS
@@ -132,12 +131,12 @@ class SimRobot:
         radii = {
             d.wheel_joint: b.r_wheel for d, b in zip(description.drives, self.built) if b.r_wheel != d.wheel_radius
         }
-        if isinstance(urdf, str):
-            text = with_tyre_contact(with_wheel_radii(urdf, radii), wheels, tyre_contact_width)
-        else:  # a parsed <robot> of the robot's own (SpawnedDescription.for_pybullet): changed in place
-            set_wheel_radii(urdf, radii)
-            narrow_tyres(urdf, wheels, tyre_contact_width)
-            text = ET.tostring(urdf, encoding="unicode")
+        # a parsed <robot> (SpawnedDescription.for_pybullet) is the robot's own, changed in place
+        tree = ET.fromstring(urdf) if isinstance(urdf, str) else urdf
+        set_wheel_radii(tree, radii)
+        narrow_tyres(tree, wheels, tyre_contact_width)
+        centre_fixed_links(tree)  # LOAD_FLAGS merges fixed links: each mass where the description has it
+        text = ET.tostring(tree, encoding="unicode")
         with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
             f.write(text)
         try:

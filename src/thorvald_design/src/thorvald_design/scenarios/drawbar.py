@@ -18,7 +18,7 @@ pull and the rolling resistance: sum_driven min(mu N_i, F_i) = P + C_rr W, the l
 rearwards by the pull's moment P h about the contacts
 (:func:`thorvald_design.quasi_static.max_pull`), reported as ``predicted_pull_n``. Beside it,
 ``as_simulated`` gives the same limit for the robot as the simulator holds it (its centre of mass,
-which pybullet's merge of fixed links may put higher than the description's) standing and rolling
+measured there) standing and rolling
 (each wheel's load the surface's rolling friction ahead of its contact), for the report to say what
 a gap between the pull and its prediction owes to them.
 """

@@ -38,33 +38,27 @@ reported beside the measured one as ``predicted_climb_deg`` and ``predicted_limi
 simulated climb, a dynamic drive at speed, reaches it to within a step where traction or the motors
 limit it.
 
-Where tipping limits it, the simulated climb falls short of the prediction, by more than a step for
-the rear-driven tricycle of the drive-patterns study (12 degrees climbed, tipped at 14, where the
-prediction is 15.45). Measured on that robot on grass (its right front wheel's load, the centre of
-pressure from pybullet's contact forces, climbs at 0.5 and 0.1 m/s, with and without rolling
-friction), the causes and their sizes:
+Where tipping limits it, a rolling robot tips a little before the standing prediction. Measured on
+the rear-driven tricycle of the drive-patterns study on grass (its right front wheel's load, the
+centre of pressure from pybullet's contact forces, climbs at 0.5 and 0.1 m/s, with and without
+rolling friction), the causes and their sizes:
 
-- the simulated robot's centre of mass is 3.9 cm higher than its description's (0.538 against
-  0.499 m above the ground): pybullet 3.2.7's merge of the frame's fixed links puts each merged link's
-  mass at the link's origin, not its inertial origin (the batteries' mass 10 cm above where the
-  description has it). Alone: tipping at 14.37 degrees, -1.1;
 - rolling up the ramp each wheel's load acts 12 mm ahead of its contact (grass's rolling friction,
-  the rolling resistance's moment), which the standing prediction leaves out: -1.2 more (13.17). On
-  a 13 degree ramp the lifting wheel keeps 9.1 N without rolling friction and 3.6 N with it, the
-  5.5 N a 12 mm shift of the centre of pressure takes;
+  the rolling resistance's moment), which the standing prediction leaves out: -1.3 (15.45 to 14.17
+  degrees). On a 13 degree ramp the lifting wheel kept 9.1 N without rolling friction and 3.6 N
+  with it, the 5.5 N a 12 mm shift of the centre of pressure takes;
 - on soft ground the loaded rear wheel sinks deeper than the front ones: the frame pitches 0.3
   degrees more than the ramp: -0.3;
 - the simulated wheels touch the ground at one rim of their 1 cm contact discs, 4 mm to the left of
   their centre lines, which widens the support triangle on the battery's side: +1.0;
-- at 0.5 m/s the ramp's foot and crest jolt a robot near its limit over (13.5 degrees tipped at
-  0.5 m/s and held at 0.1 m/s): about -0.3.
+- at 0.5 m/s the ramp's foot and crest jolt a robot near its limit over: about -0.3.
 
-The simulated robot holds 13 degrees with 3.6 N left on its lifting wheel, and tips at 13.5. The
-results carry the first two causes (``as_simulated``: the centre of mass's heights, and the
-predictions of the robot as simulated, standing and rolling: 13.17 degrees for the tricycle, which
-its tries bracket), and the report says so where a climb and its prediction differ by more than a
-step. The procedure is left as it is: the first two are what the simulator's robot is (the first a
-fault of the simulator's loading, the second real tyres' too), the rest the simulation's physics.
+It climbs 14 degrees and tips at 16, within a step of the prediction. (Before the simulator placed
+each merged link's mass where the description has it, its centre of mass sat 3.9 cm high and it
+tipped at 14.) The results carry the centre of mass's heights and the predictions of the robot as
+simulated, standing and rolling (``as_simulated``: 14.17 degrees rolling for the tricycle), and the
+report says so where a climb and its prediction differ by more than a step. The procedure is left
+as it is: the rolling resistance's moment is real tyres' too, the rest the simulation's physics.
 """
 
 import math
