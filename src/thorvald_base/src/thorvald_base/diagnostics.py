@@ -20,6 +20,10 @@ OK = 0
 WARN = 1
 ERROR = 2
 
+LOST = "wheels stopped: lost"  # the link's key of the devices heard, then silent past their timeout
+NOT_HEARD_YET = "wheels stopped: not heard since start"  # and of those never heard since base_driver started
+PATIENCE = 5  # looks (a second apart) a device may stay unheard since start before it is logged
+
 
 @dataclass(frozen=True)
 class Status:
@@ -82,8 +86,8 @@ def base_statuses(
         values = (("voltage", f"{b.voltage:.2f}"), ("state of charge", f"{b.state_of_charge:.0f} %"))
         statuses.append(Status(f"{prefix}battery {b.id}", f"battery {b.id}", level, message, values))
     if link:
-        failing = "closed" in link.get("bus", "") or link.get("wheels stopped: lost") or link.get("wrong script")
-        level = ERROR if failing else OK
+        failing = "closed" in link.get("bus", "") or link.get(LOST) or link.get("wrong script")
+        level = ERROR if failing else (WARN if link.get(NOT_HEARD_YET) else OK)
         statuses.append(Status(f"{prefix}CAN bus", "can", level, link.get("bus", ""), tuple(link.items())))
     return statuses
 
@@ -112,21 +116,44 @@ class OdometryWatch:
 class LinkWatch:
     """The warnings a change of the hardware link deserves, each said once when it changes."""
 
-    WATCHED = ("last error", "wheels stopped: lost", "wrong script")
+    WATCHED = ("last error", LOST, "wrong script")
 
     def __init__(self):
         self._seen: Dict[str, Optional[str]] = {}
+        self._unheard_looks = 0  # consecutive looks with devices not heard since start
 
     def changes(self, link: Dict[str, str]) -> List[str]:
+        """The lines to log for this look at the link (one a second). Devices not heard since start are
+        normal for the first moments (their first reports are on their way): said only when they stay
+        unheard for PATIENCE looks."""
         out = []
         for key in self.WATCHED:
             value = link.get(key)
             if value and value != self._seen.get(key):
                 out.append(f"CAN: {key}: {value}")
-            if value is None and self._seen.get(key) and key == "wheels stopped: lost":
+            if value is None and self._seen.get(key) and key == LOST:
                 out.append("CAN: every device heard again: the wheels follow commands")
             self._seen[key] = value
+        unheard = link.get(NOT_HEARD_YET)
+        self._unheard_looks = self._unheard_looks + 1 if unheard else 0
+        if self._unheard_looks == PATIENCE:
+            out.append(
+                f"CAN: {NOT_HEARD_YET}: {unheard} (check each controller's node id in the robot file, its power "
+                "and the bus's wiring and termination)"
+            )
         return out
 
 
-__all__ = ["ERROR", "OK", "WARN", "LinkWatch", "OdometryWatch", "Status", "base_statuses", "odometry_sentence"]
+__all__ = [
+    "ERROR",
+    "LOST",
+    "NOT_HEARD_YET",
+    "OK",
+    "PATIENCE",
+    "WARN",
+    "LinkWatch",
+    "OdometryWatch",
+    "Status",
+    "base_statuses",
+    "odometry_sentence",
+]

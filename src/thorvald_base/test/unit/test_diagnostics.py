@@ -4,7 +4,7 @@ from diagnostic_msgs.msg import DiagnosticStatus
 
 from thorvald_base import diagnostics
 from thorvald_base.bases import BatteryInfo, ControllerInfo
-from thorvald_base.diagnostics import ERROR, OK, WARN, LinkWatch, base_statuses
+from thorvald_base.diagnostics import ERROR, NOT_HEARD_YET, OK, PATIENCE, WARN, LinkWatch, base_statuses
 from thorvald_base.modes import BATTERY_LOST, BATTERY_OK, MODE_LOST_CONNECTION, MODE_ONLINE
 
 
@@ -66,3 +66,17 @@ def test_link_changes_are_said_once():
     assert watch.changes({"wheels stopped: lost": "drive1"}) == ["CAN: wheels stopped: lost: drive1"]
     assert watch.changes({}) == ["CAN: every device heard again: the wheels follow commands"]
     assert watch.changes({}) == []
+
+
+def test_devices_not_heard_since_start_are_no_loss_and_logged_only_when_they_stay_unheard():
+    """At start the controllers' first reports are on their way: the wheels wait, the bus is a warning,
+    and nothing is logged unless a device stays unheard for PATIENCE looks (a wrong node id)."""
+    link = {"bus": "open", NOT_HEARD_YET: "drive0, drive1"}
+    (status,) = base_statuses("", [], [], link)
+    assert status.level == WARN
+    watch = LinkWatch()
+    assert all(watch.changes(link) == [] for _ in range(PATIENCE - 1))
+    (line,) = watch.changes(link)
+    assert line.startswith("CAN: wheels stopped: not heard since start: drive0, drive1 (check each controller")
+    assert watch.changes(link) == []  # said once
+    assert watch.changes({"bus": "open"}) == []  # heard: no loss to recover from

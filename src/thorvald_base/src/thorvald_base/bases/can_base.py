@@ -22,6 +22,7 @@ import can
 from ..can import protocol as pr
 from ..can.devices import Battery, IoBoard, MotorController
 from ..can.outbox import Outbox, Waiting, write_refused
+from ..diagnostics import LOST, NOT_HEARD_YET
 from ..errors import ParameterError, ThorvaldBaseError
 from ..kinematics import DriveCommand
 from ..modes import BATTERY_ALARM, BATTERY_LOST, BATTERY_OK, MODE_DRIVE, MODE_HOME, MODE_LOST_CONNECTION, MODE_ONLINE
@@ -122,6 +123,7 @@ class CanBase(BaseHandle):
         self.wheel_angles = [0.0] * len(config.drives)
         self._last_read: Optional[float] = None
         self.stopped_for_lost: List[str] = []
+        self.not_heard_yet: List[str] = [c.name for c in self.controllers_]
         self.muted = False
         self.allow_relay_to_base = False
         self._pending: List[Tuple[int, bytes]] = [b.command_frame(b.initial) for b in self.ios]
@@ -149,9 +151,11 @@ class CanBase(BaseHandle):
     # ---- the cycle -------------------------------------------------------------------------------
     def _send_drive_commands(self, commands, time):
         self._poll(time)
-        lost = [c.name for c in self.controllers_ if not c.online(time)]
-        self.stopped_for_lost = lost
-        if lost or self.homing:
+        silent = [c for c in self.controllers_ if not c.online(time)]
+        # lost: heard, then silent; a controller never heard since start is not lost, only not there yet
+        self.stopped_for_lost = [c.name for c in silent if c.last_heard is not None]
+        self.not_heard_yet = [c.name for c in silent if c.last_heard is None]
+        if silent or self.homing:
             commands = [DriveCommand(c.steering, 0.0) for c in commands]
         for controller in self.controllers_:
             self._queue(controller.command_frames([commands[k] for k in controller.indices]))
@@ -443,7 +447,9 @@ class CanBase(BaseHandle):
         if c.last_refused:
             values["last write refused"] = c.last_refused
         if self.stopped_for_lost:
-            values["wheels stopped: lost"] = ", ".join(self.stopped_for_lost)
+            values[LOST] = ", ".join(self.stopped_for_lost)
+        if self.not_heard_yet:
+            values[NOT_HEARD_YET] = ", ".join(self.not_heard_yet)
         mismatches = [c.script_mismatch for c in self.controllers_ if c.script_mismatch]
         if mismatches:
             values["wrong script"] = "; ".join(mismatches)
