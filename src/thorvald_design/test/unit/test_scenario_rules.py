@@ -6,11 +6,12 @@ import math
 import pytest
 
 from thorvald_design.scenarios import SCENARIOS
-from thorvald_design.scenarios.driving import feasible_twist, ramp_world
+from thorvald_design.scenarios.driving import Progress, feasible_twist, ramp_world
 from thorvald_design.scenarios.gradeability import angles
 from thorvald_design.scenarios.headland import field
 from thorvald_design.scenarios.obstacle import heights, step_world
-from thorvald_design.scenarios.side_slope import side_slope_world
+from thorvald_design.scenarios.kind import Pose
+from thorvald_design.scenarios.side_slope import _traverse_outcome, side_slope_world
 from thorvald_design.scenarios.turning import turn_centre, turn_twist
 from thorvald_model import load_robot_config
 from thorvald_model.description import package_file
@@ -83,3 +84,25 @@ def test_a_ramp_rises_at_its_angle_from_its_foot():
     assert w.ground_height(0.0, 0.0) == pytest.approx(0.0, abs=1e-9)
     assert w.ground_height(1.5, 0.0) == pytest.approx(1.5 * math.tan(math.radians(20)), abs=1e-6)
     assert w.ground_height(4.0, 0.0) == pytest.approx(3.0 * math.tan(math.radians(20)), abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    "way, across, outcome",
+    [
+        # heading +x, the face rising to +y: downhill is -y, to the right
+        (1.0, -0.02 * 5, "ok"),
+        (1.0, -0.10 * 5, "drifted 0.100 m per m"),
+        (1.0, +0.96 * 5, "veered 0.960 m per m uphill"),
+        # heading -x: downhill is -y, to the left of the heading
+        (-1.0, -0.10 * 5, "drifted 0.100 m per m"),
+        (-1.0, +0.10 * 5, "veered 0.100 m per m uphill"),
+    ],
+)
+def test_a_traverse_holds_its_line_either_way(way, across, outcome):
+    """A traverse of 5 m that ends `across` m off its line in y: held within max_drift (0.05 m per m)
+    of its line, downhill or uphill; the drift reported is signed, downhill positive."""
+    heading = 0.0 if way > 0 else math.pi
+    poses = [Pose(k * 0.5, way * k * 0.5, across * k / 10, 0.0, 0.0, 0.0, heading) for k in range(11)]
+    found, downhill = _traverse_outcome(poses, Progress(ux=way), way, heading, {"distance": 5.0, "max_drift": 0.05})
+    assert found == outcome
+    assert downhill == pytest.approx(-across / 5)

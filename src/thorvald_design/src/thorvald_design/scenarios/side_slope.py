@@ -12,8 +12,10 @@ From ground truth:
   (:func:`thorvald_design.metrics.lateral_drift`): the sideways slip of the tyres the slope's
   downhill pull causes, which a robot holding its heading cannot correct (0: the wheels do not slip
   sideways; tan of the crab angle it slides at otherwise);
-- a traverse is held when the robot covers the distance, does not tip, and drifts at most
-  ``max_drift`` [m per m] downhill; ``max_traverse_deg`` is the steepest held.
+- a traverse is held when the robot covers the distance, does not tip, and ends at most
+  ``max_drift`` [m per m] off its line, downhill or uphill (a robot that veers up the slope does not
+  hold the traverse either: the differential robot ended 0.96 m per m uphill of its line at 10
+  degrees); ``max_traverse_deg`` is the steepest held.
 
 ``static_overturning_deg`` is ISO 16231-2's static overturning angle to the side, from the centre of
 mass and the wheel contacts, not from the drive: the tilt about the support polygon's side edge (the
@@ -21,9 +23,9 @@ line through the downhill wheels' contacts) at which the vertical through the ce
 over that edge, atan(d / h), d the horizontal distance from the centre of mass to the edge and h its
 height above the ground (:func:`thorvald_design.quasi_static.overturning_angles`); the smaller of the
 two sides. No robot should be driven near it: slip comes first on any real surface. Beside it,
-``as_simulated`` gives the angle of the robot as the simulator holds it (its centre of mass, which
-pybullet's merge of fixed links may put higher than the description's), for the report to say what
-a traverse that tipped before the static angle owes to it.
+``as_simulated`` gives the angle of the robot as the simulator holds it (its centre of mass,
+measured there), for the report to say what a traverse that tipped before the static angle owes to
+it.
 """
 
 import math
@@ -150,6 +152,8 @@ def _traverse_outcome(poses, progress: Progress, way: float, heading: float, par
     downhill = -way * lateral_drift(track, heading).per_m
     if downhill > params["max_drift"]:
         return f"drifted {downhill:.3f} m per m", downhill
+    if -downhill > params["max_drift"]:  # off its line uphill: it does not hold the traverse either
+        return f"veered {-downhill:.3f} m per m uphill", downhill
     return "ok", downhill
 
 
