@@ -9,8 +9,8 @@ from thorvald_design.scenarios import SCENARIOS
 from thorvald_design.scenarios.driving import Progress, feasible_twist, ramp_world
 from thorvald_design.scenarios.gradeability import angles
 from thorvald_design.scenarios.headland import field
-from thorvald_design.scenarios.obstacle import heights, step_world
 from thorvald_design.scenarios.kind import Pose
+from thorvald_design.scenarios.obstacle import heights, step_world
 from thorvald_design.scenarios.side_slope import _traverse_outcome, side_slope_world
 from thorvald_design.scenarios.turning import turn_centre, turn_twist
 from thorvald_model import load_robot_config
