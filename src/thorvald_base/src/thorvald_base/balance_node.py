@@ -49,13 +49,15 @@ from thorvald_model.motors import Motor, output_torque, propulsion_motor
 from thorvald_msgs.msg import ControllerArray, DriveParam
 from thorvald_msgs.srv import DriveParams
 
+from .calibration.balancer import Balancer
 from .calibration.calibration_file import CalibrationValues, changes_yaml, read_calibration
-from .calibration.toe_balance import ToeSearch, resistance
-from .calibration.torque_balance import BalanceFit, Leg, fight_power, fit_balance, next_radii
+from .calibration.toe_balance import ToeSearch
+from .calibration.torque_balance import Leg, fight_power
 from .errors import CalibrationError
 from .verification import BALANCE_SPEED, BalanceWindow, balance_legs
 from .verification_node import VerificationDrive
 
+NO_BALANCE = 3  # the exit status when the legs could not support a balance (the report says why)
 DECIDE_AFTER = 1.5  # [s] after a leg's end: its last motor_controller_data has arrived (1 Hz)
 MIN_SAMPLES = 3  # motor_controller_data messages a leg must hold
 
@@ -70,20 +72,10 @@ class BalanceDrive(VerificationDrive):
         config = self.config
         for index, key, value in self.calibration:
             config = config.with_drive_param(index, key, value)
-        self.radii: Tuple[float, ...] = tuple(d.r_wheel for d in config.drives)
-        self.start_radii = self.radii
-        self.offsets: Tuple[float, ...] = tuple(d.steering_offset for d in config.drives)
-        self.start_offsets = self.offsets
         self.out = str(rospy.get_param("~out", "") or "")
         self.json = str(rospy.get_param("~json", "") or "")
         self.windows: List[BalanceWindow] = balance_legs(self.plan)
-        self.legs: List[Leg] = []  # every leg measured, in order
-        self.first: Optional[BalanceFit] = None  # the radii's first legs' fit, once the toe search starts
-        self.toe: Optional[ToeSearch] = None
-        if any(w.kind == "toe" for w in self.windows):
-            self.toe = ToeSearch(self.config, self.offsets)
-            if self.toe.legs != sum(w.kind == "toe" for w in self.windows):
-                raise RuntimeError("the balance manoeuvre's toe legs are not the toe search's")
+        self.balancer = Balancer(config, [w.kind for w in self.windows])
         self.samples: List[Tuple[float, Tuple[float, ...]]] = []  # (stamp, propulsion amps per drive)
         self.service = rospy.resolve_name(str(rospy.get_param("~drive_params_service", "base_driver/set_drive_params")))
         rospy.Subscriber(
@@ -106,68 +98,39 @@ class BalanceDrive(VerificationDrive):
         self.samples.append((msg.header.stamp.to_sec(), tuple(amps)))
 
     def during(self, start: float, t: float) -> None:
-        while len(self.legs) < len(self.windows) and t >= self.windows[len(self.legs)].end + DECIDE_AFTER:
-            window = self.windows[len(self.legs)]
-            self.legs.append(self.measure(start, window.begin, window.end, window.speed))
-            if window.kind == "toe":
-                self.toe.record(resistance(self.legs[-1]))
-            if len(self.legs) < len(self.windows):
-                self.next_leg(self.windows[len(self.legs)])
-
-    def radii_legs(self, part: int) -> List[Leg]:
-        """The legs of the radii before the toe search (part 0) or after it (1)."""
-        kinds = [w.kind for w in self.windows[: len(self.legs)]]
-        first_toe = kinds.index("toe") if "toe" in kinds else len(kinds)
-        legs = list(zip(kinds, self.legs))[first_toe:] if part else list(zip(kinds, self.legs))[:first_toe]
-        return [leg for kind, leg in legs if kind == "radii"]
-
-    def next_leg(self, window: BalanceWindow) -> None:
-        """Sets the radii or the steering offsets the next leg is driven with."""
-        if window.kind == "toe":
-            if self.first is None:  # the toe search starts with the radii balanced: the first legs' fit
-                self.first = fit_balance(self.radii_legs(0))
-                self.apply(self.first.radii)
-            self.apply_offsets(self.toe.offsets())
-        elif self.first is None:
-            self.apply(next_radii(self.radii_legs(0)))
-        else:
-            if self.offsets != self.toe.result:
-                self.apply_offsets(self.toe.result)
-            again = self.radii_legs(1)
-            if again:  # the stiffness known from the first legs: every leg after the search gives the radii
-                self.apply(next_radii(again, stiffness_prior=self.first.stiffness))
-
-    def balanced(self) -> BalanceFit:
-        """The fit of the last part's legs of the radii (with the stiffness of the first, after a toe search)."""
-        if self.first is None:
-            return fit_balance(self.radii_legs(0))
-        return fit_balance(self.radii_legs(1), stiffness_prior=self.first.stiffness)
+        balancer = self.balancer
+        while len(balancer.legs) < len(self.windows) and t >= self.windows[len(balancer.legs)].end + DECIDE_AFTER:
+            window = self.windows[len(balancer.legs)]
+            was = balancer.stopped
+            balancer.record(self.measure(start, window.begin, window.end, window.speed))
+            radii, offsets = balancer.next()
+            if balancer.stopped is not None and was is None:
+                rospy.logwarn("balance_wheels: %s; the rest of the drive with the radii and offsets it started with",
+                              balancer.stopped)  # fmt: skip
+            if radii is not None:
+                self.set_params("r_wheel", radii, "radii")
+            if offsets is not None:
+                steered = [k for k, d in enumerate(self.config.drives) if d.steerable]
+                self.set_params("steering_offset", [offsets[k] for k in steered], "steering offsets", steered)
 
     def measure(self, start: float, begin: float, end: float, speed: float) -> Leg:
         """The leg's mean wheel torques over its measured part, from the currents reported in it."""
+        legs = len(self.balancer.legs)
         rows = [amps for stamp, amps in self.samples if start + begin <= stamp <= start + end]
         rows = [amps for amps in rows if all(math.isfinite(a) for a in amps)]
         if len(rows) < MIN_SAMPLES:
             raise RuntimeError(
                 f"{len(rows)} motor_controller_data messages with every drive's current during balance leg "
-                f"{len(self.legs) + 1} ({begin:.0f} to {end:.0f} s): is base_driver publishing them?"
+                f"{legs + 1} ({begin:.0f} to {end:.0f} s): is base_driver publishing them?"
             )
-        rates = [speed / r for r in self.radii]
+        radii = self.balancer.radii
+        rates = [speed / r for r in radii]
         torques = np.mean(
             [[output_torque(m, a, w) for m, a, w in zip(self.motors, amps, rates)] for amps in rows], axis=0
         )
         if not np.any(np.abs(np.mean(rows, axis=0)) > 0.0):
             raise RuntimeError("every motor current reads 0: this base does not measure its motors' currents")
-        return Leg(self.radii, speed, tuple(float(t) for t in torques), tuple(rates), end - begin, len(rows))
-
-    def apply(self, radii: Sequence[float]) -> None:
-        self.set_params("r_wheel", radii, "radii")
-        self.radii = tuple(float(r) for r in radii)
-
-    def apply_offsets(self, offsets: Sequence[float]) -> None:
-        steered = [k for k, d in enumerate(self.config.drives) if d.steerable]
-        self.set_params("steering_offset", [offsets[k] for k in steered], "steering offsets", steered)
-        self.offsets = tuple(float(o) for o in offsets)
+        return Leg(radii, speed, tuple(float(t) for t in torques), tuple(rates), end - begin, len(rows))
 
     def set_params(self, key: str, values: Sequence[float], what: str, indices: Optional[Sequence[int]] = None) -> None:
         indices = list(range(len(values))) if indices is None else list(indices)
@@ -180,14 +143,27 @@ class BalanceDrive(VerificationDrive):
         if answer.status < len(params):
             raise RuntimeError(f"{self.service} refused the {what}: {answer.message}")
 
-    def balance(self) -> str:
-        """Drives the legs; the report, having written ~out."""
+    def balance(self) -> Tuple[str, bool]:
+        """Drives the legs; (the report, whether a balance was found), having written ~out (when found)
+        and ~json (the legs, and the balance or why there is none)."""
         self.run()
-        if len(self.legs) < len(self.windows):
-            raise RuntimeError(f"the drive ended after {len(self.legs)} of {len(self.windows)} legs")
-        fit = self.balanced()
-        toe = self.toe
-        text = report(self.name, self.legs, fit, self.start_radii, self.motors, description=self.description, toe=toe)
+        balancer = self.balancer
+        if len(balancer.legs) < len(self.windows):
+            raise RuntimeError(f"the drive ended after {len(balancer.legs)} of {len(self.windows)} legs")
+        try:
+            fit = balancer.result()
+        except CalibrationError as e:
+            text = report(self.name, balancer.legs, None, balancer.start_radii, self.motors,
+                          description=self.description)  # fmt: skip
+            text += f"\n{e}: no balance; the calibration it started with stands"
+            if self.json:
+                with open(self.json, "w") as f:
+                    json.dump(as_json(balancer.legs, None, balancer.start_radii, self.motors, stopped=str(e)), f,
+                              indent=2)  # fmt: skip
+            return text, False
+        toe = balancer.toe
+        text = report(self.name, balancer.legs, fit, balancer.start_radii, self.motors, description=self.description,
+                      toe=toe)  # fmt: skip
         if self.out:
             changes = [(k, "r_wheel", r) for k, r in enumerate(fit.radii)]
             if toe is not None:
@@ -202,8 +178,8 @@ class BalanceDrive(VerificationDrive):
             text += f"\nwrote {os.path.abspath(self.out)}"
         if self.json:
             with open(self.json, "w") as f:
-                json.dump(as_json(self.legs, fit, self.start_radii, self.motors, toe=toe), f, indent=2)
-        return text
+                json.dump(as_json(balancer.legs, fit, balancer.start_radii, self.motors, toe=toe), f, indent=2)
+        return text, True
 
 
 def report(
@@ -215,6 +191,8 @@ def report(
     for k, leg in enumerate(legs):
         way = "forwards" if leg.speed > 0 else "back"
         lines.append(f"{k + 1:<4} {way:<10} {leg.fight:>11.2f}  {max(fight_power(leg, motors), 0.0):>9.1f}")
+    if fit is None:  # the balance stopped: the legs only
+        return "\n".join(lines)
     lines += ["", "drive    r_wheel [m]   balanced [m]   change [%]   +- [%]"]
     for k, (before, after, sd) in enumerate(zip(start, fit.radii, fit.sd)):
         change, spread = 100 * (after / before - 1), 100 * sd / after
@@ -240,21 +218,26 @@ def report(
     return "\n".join(lines)
 
 
-def as_json(legs: Sequence[Leg], fit, start: Sequence[float], motors: Sequence[Motor], toe=None) -> dict:
-    """The report's figures."""
+def as_json(
+    legs: Sequence[Leg], fit, start: Sequence[float], motors: Sequence[Motor], *, toe=None, stopped: str = ""
+) -> dict:
+    """The report's figures; with the balance stopped (fit None), the legs and why (``stopped``)."""
     out = {
         "legs": [
             {"speed": leg.speed, "fight_nm": leg.fight, "fight_w": max(fight_power(leg, motors), 0.0),
              "torques_nm": list(leg.torques), "samples": leg.samples}
             for leg in legs
         ],
-        "stiffness": fit.stiffness,
-        "residual_nm": fit.residual,
-        "drives": {
-            f"drive{k}": {"r_wheel_before": before, "r_wheel": after, "sd": sd}
-            for k, (before, after, sd) in enumerate(zip(start, fit.radii, fit.sd))
-        },
     }  # fmt: skip
+    if fit is None:
+        out["stopped"] = stopped
+        return out
+    out["stiffness"] = fit.stiffness
+    out["residual_nm"] = fit.residual
+    out["drives"] = {
+        f"drive{k}": {"r_wheel_before": before, "r_wheel": after, "sd": sd}
+        for k, (before, after, sd) in enumerate(zip(start, fit.radii, fit.sd))
+    }
     if toe is not None:
         out["toe"] = {
             "legs": toe.legs,
@@ -274,7 +257,7 @@ def as_json(legs: Sequence[Leg], fit, start: Sequence[float], motors: Sequence[M
 def main():
     rospy.init_node("balance_wheels")
     try:
-        text = BalanceDrive().balance()
+        text, found = BalanceDrive().balance()
     except ConfigError as e:
         rospy.logfatal("balance_wheels: %s", e)
         sys.exit(2)
@@ -283,3 +266,5 @@ def main():
         sys.exit(1)
     print(text, flush=True)
     rospy.signal_shutdown("balance drive done")
+    if not found:
+        sys.exit(NO_BALANCE)

@@ -27,8 +27,14 @@ twice) is driven with all that in effect, and odometry's yaw-rate multiplier fit
 (``calibrate_odometry --fit turns``): calibration.yaml, what base_driver loads. The tyres slip in a
 turn, and no radius or offset makes the wheels' geometry read a turn as the body turns.
 
+A balance that the legs cannot support stops (balance_wheels says why: wheels whose torques do not
+follow their radii, a radius beyond what a tyre's pressure and wear give, a fight that did not
+shrink, a radius the robot file's rules refuse): the calibration from ground truth then stands, a
+warning says so, and the straight legs and the turns follow with it; ``--require-balance`` exits 3
+there instead.
+
 Exit status 0 with the calibration; 2 with the reason on stderr (a robot file's problems, one per
-line; otherwise one line) and no traceback.
+line; otherwise one line) and no traceback; 3 (``--require-balance``) when the balance stopped.
 """
 
 import argparse
@@ -63,6 +69,7 @@ BALANCED_FIT = "balanced_calibration.yaml"  # the calibration drive's fit with t
 STRAIGHT_BAG = "straight.bag"
 SCALED = "scaled_calibration.yaml"  # the straight legs' common factor on the balanced fit, before the turns
 TURNS_BAG = "turns.bag"
+NO_BALANCE = 3  # the exit status with --require-balance when the balance stopped (balance_wheels' own)
 
 
 def parser() -> argparse.ArgumentParser:
@@ -90,6 +97,11 @@ def parser() -> argparse.ArgumentParser:
         help="then balance the wheels from their motor currents (default: a robot of more than two drives)",
     )  # fmt: skip
     balance.add_argument("--no-balance", dest="balance", action="store_false", help="calibrate from ground truth alone")
+    p.add_argument(
+        "--require-balance", action="store_true",
+        help="exit 3 when the balance stops (the legs cannot support one): by default the calibration from ground "
+        "truth stands, with a warning, and the drive goes on",
+    )  # fmt: skip
     p.add_argument(
         "--no-turns", dest="turns", action="store_false",
         help="leave out the last drive, the U turns that fit odometry's yaw-rate multiplier",
@@ -184,28 +196,39 @@ def run(args) -> int:
         argparse.Namespace(**{**vars(args), "calibration": first}), "balance_wheels.launch", launch_args, log,
         f"{os.path.basename(model)[:-5]} through the balance manoeuvre, its steering offsets calibrated",
     )  # fmt: skip
-    if not (os.path.isfile(balanced_file) and os.path.isfile(figures)):
+    balanced = None
+    if os.path.isfile(figures):
+        with open(figures) as f:
+            balanced = json.load(f)
+    stopped = (balanced or {}).get("stopped")
+    if balanced is None or not (stopped or os.path.isfile(balanced_file)):
         tail = "\n".join(said.splitlines()[-25:])
         raise DriveError(f"the balancing drive did not finish (no balanced calibration); see {log}", tail)
-    with open(figures) as f:
-        balanced = json.load(f)
     if not args.json:
         start = said.find("balance_wheels: ")
         print(f"  drive: {wall:.1f} s wall", flush=True)
         print(said[start:].split("\n[", 1)[0].rstrip() if start >= 0 else "", flush=True)
-        print(
-            "\nthe calibration drive's fit, each radius moved to the balance's along what that drive did not determine:"
-        )
-    # the calibration drive's fit again, with the balance
-    captured = io.StringIO()
-    with contextlib.redirect_stdout(captured):
-        status = calibrate_odometry([*command[:4], balanced_fit, *command[5:], "--balance", balanced_file])
-    if status != 0:
-        print(captured.getvalue(), end="")
-        return status
-    fit_text = captured.getvalue()
-    if not args.json:
-        print(fit_text, end="", flush=True)
+    if stopped:
+        print(f"calibration_drive: warning: {stopped}; the calibration from ground truth stands", file=sys.stderr)
+        if args.require_balance:
+            return NO_BALANCE
+        balanced_fit, fit_text = first, text  # the calibration drive's fit, as ground truth left it
+    else:
+        if not args.json:
+            print(
+                "\nthe calibration drive's fit, each radius moved to the balance's along what that drive did not "
+                "determine:"
+            )
+        # the calibration drive's fit again, with the balance
+        captured = io.StringIO()
+        with contextlib.redirect_stdout(captured):
+            status = calibrate_odometry([*command[:4], balanced_fit, *command[5:], "--balance", balanced_file])
+        if status != 0:
+            print(captured.getvalue(), end="")
+            return status
+        fit_text = captured.getvalue()
+        if not args.json:
+            print(fit_text, end="", flush=True)
     # the radii's common factor, from straight legs at working speed with all that in effect
     straight_bag = os.path.join(out, STRAIGHT_BAG)
     with_fit = argparse.Namespace(**{**vars(args), "calibration": balanced_fit})
@@ -228,7 +251,7 @@ def run(args) -> int:
     if args.turns:
         turns = turns_step(args, model, scaled, out, calibrate_odometry)
     tyres = None
-    if args.as_built:
+    if args.as_built and not stopped:
         tyres = tyre_errors(config, built, load_calibration(first, config), balanced, load_calibration(final, config))
     if args.json:  # the calibration drive's fit (with the balance), the balance, the straight legs' factor
         result = json.loads(fit_text[fit_text.index("{") :])

@@ -96,6 +96,10 @@ PROFILES: Dict[str, Profile] = {
     # radius a configuration states (10 to 20 mm of deflection at field pressures on 0.2 m tyres: 1 to
     # 2 %), so odometry on the configured radius reads long, as the paper's (+1.0 %)
     "field": Profile(radius=0.01, steering_offset=math.radians(0.5), encoders=True, loaded=(0.01, 0.02)),
+    # A robot as the workshop leaves it, before the field: only its tyres' radii (+-0.85 % each, up to
+    # 1.7 % apart: pressure and wear) and its steering's homing (+-0.3 deg) off; rigid, unloaded tyres
+    # (a six-wheeled frame then stands on the wheels its radii favour), exact encoders
+    "workshop": Profile(radius=0.0085, steering_offset=math.radians(0.3), encoders=False),
 }
 
 

@@ -16,6 +16,8 @@ import sys
 from typing import List, Optional
 
 from thorvald_model import ConfigError, load_robot_config
+from thorvald_model.errors import UnknownRobotError
+from thorvald_model.examples import robot_file
 from thorvald_model.values import RobotConfig
 
 from .as_built import AsBuilt, SimAsBuilt, as_built_for, for_simulator
@@ -91,15 +93,20 @@ def main(argv: Optional[List[str]] = None) -> int:
         "differs from, without starting the simulator.",
     )
     parser.add_argument("as_built", metavar="FILE", help="as-built YAML file, or PROFILE:SEED (e.g. field:7)")
-    parser.add_argument("--robot-model", required=True, metavar="ROBOT", help="the robot configuration file")
+    parser.add_argument(
+        "--robot-model", required=True, metavar="ROBOT", help="an example robot's name or a robot configuration file"
+    )
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     args = parser.parse_args(argv)
     try:
-        config = load_robot_config(args.robot_model)
+        config = load_robot_config(robot_file(args.robot_model))
         built = as_built_for(args.as_built, config)
         sim = for_simulator(built, config)
     except ConfigError as e:
         print(e, file=sys.stderr)  # FILE: key path: value: rule, as every command that reads these files
+        return 2
+    except UnknownRobotError as e:
+        print(f"check_as_built: --robot-model {e}", file=sys.stderr)
         return 2
     s = summary(built, sim, config)
     if args.json:

@@ -128,6 +128,17 @@ def test_the_field_profile_is_seeded_and_within_its_tolerances():
     assert all(d.steering_offset == 0 for d in draw_as_built("field:3", DIFF).drives)
 
 
+def test_the_workshop_profile_is_radii_and_homing_alone():
+    drawn = [draw_as_built(f"workshop:{s}", STD) for s in range(200)]
+    for built in drawn:
+        assert not built.encoders and built.loaded == 0.0 and built.tyre_deflection == 0.0
+        for d, conf in zip(built.drives, STD.drives):
+            assert abs(d.r_wheel / conf.r_wheel - 1) <= 0.0085
+            assert abs(d.steering_offset) <= math.radians(0.3)
+    scales = [d.drives[0].r_wheel / STD.drives[0].r_wheel - 1 for d in drawn]
+    assert min(scales) < -0.007 and max(scales) > 0.007  # uniform over +-0.85 %
+
+
 def test_as_built_for_takes_nothing_a_profile_or_a_file(tmp_path):
     assert as_built_for("", STD).ideal
     assert as_built_for("field:4", STD) == draw_as_built("field:4", STD)
