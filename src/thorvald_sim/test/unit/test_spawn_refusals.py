@@ -97,7 +97,9 @@ def test_a_malformed_seed_is_refused_with_the_rule(spec):
 def test_an_unknown_profile_is_named_with_the_known_ones():
     with pytest.raises(ConfigError) as info:
         as_built_for("nosuch:3", STD)
-    assert str(info.value) == "nosuch:3: no as-built profile 'nosuch' (the profiles: field, workshop) and no file of that name"
+    assert str(info.value) == (
+        "nosuch:3: no as-built profile 'nosuch' (the profiles: field, workshop) and no file of that name"
+    )
 
 
 def test_seeds_at_the_bounds_are_drawn():
