@@ -232,6 +232,13 @@ def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determi
     for name in (*names, "scaled_calibration.yaml", "calibration_drive.bag", "straight.bag", "turns.bag"):
         assert os.path.isfile(os.path.join(out, name)), name
     assert "field:3 on the field route against RTK-GNSS: uncalibrated" in demo
+    # what the calibration applied, and how much of it the calibration drive determined
+    determined = sum(1 for c in result["combinations"] if c["determined"])
+    assert (
+        f"applied build/calibration_drive/calibration.yaml: each drive's radius and steering offset from the "
+        f"calibration drive ({determined} of 12 combinations determined; the other {12 - determined} from the balance"
+    ) in demo
+    assert f"the yaw-rate multiplier {multiplier:.5f} from U turns" in demo
     # validated on a different drive, the field route, within issue 34's targets against both
     with open(os.path.join(WS, "build", "field_route_calibrated", "figures.json")) as f:
         route = json.load(f)
