@@ -196,7 +196,7 @@ def report(
     lines += ["", "drive    r_wheel [m]   balanced [m]   change [%]   +- [%]"]
     for k, (before, after, sd) in enumerate(zip(start, fit.radii, fit.sd)):
         change, spread = 100 * (after / before - 1), 100 * sd / after
-        lines.append(f"drive{k:<3} {before:>11.5f}   {after:>12.5f}   {change:>+10.3f}   {spread:>6.3f}")
+        lines.append(f"drive{k:<3} {before:>11.5f}   {after:>12.5f}   {change:>+10.3f}   {spread:>6.2g}")
     if toe is not None:
         lines += ["", "drive    steering_offset [deg]   found [deg]   change [deg]"]
         for k in toe.drives:

@@ -480,7 +480,7 @@ def print_text(outcome: Outcome) -> None:
         used = scale.used
         left = len(scale.legs) - len(used)
         print(
-            f"the radii's common factor: {scale.factor:.5f} ± {scale.sd:.5f} "
+            f"the radii's common factor: {scale.factor:.5f} ± {scale.sd:.2g} "
             f"({100 * (scale.factor - 1):+.3f} %), ground truth's {sum(leg.truth_m for leg in used):.2f} m against "
             f"odometry's {sum(leg.odometry_m for leg in used):.2f} m"
             + (f"; {left} legs left out (turned or short)" if left else "")

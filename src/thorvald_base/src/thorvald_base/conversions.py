@@ -73,12 +73,13 @@ def command_msg(
 
 
 def state_msg(stamp, states: Sequence[MeasuredDrive], homing: bool = False, channels: Sequence[int] = ()) -> BaseState:
-    """Measured (or simulated) drive states (base_state, drive_states)."""
+    """Measured (or simulated) drive states (base_state, drive_states). An unheard drive's speeds are
+    NaN: its last report is no measurement of how it moves now (its angles stay the last heard)."""
     msg = BaseState(drive_mode=BaseState.MODE_HOME if homing else BaseState.MODE_DRIVE)
     msg.header.stamp = stamp
-    msg.prop_speed = [s.speed for s in states]
+    msg.prop_speed = [s.speed if s.heard else math.nan for s in states]
     msg.prop_pos = [s.wheel_angle for s in states]
-    msg.steer_speed = [s.steering_speed for s in states]
+    msg.steer_speed = [s.steering_speed if s.heard else math.nan for s in states]
     msg.steer_pos = [s.steering for s in states]
     msg.channel = list(channels)
     return msg

@@ -44,8 +44,12 @@ def odometry_sentence(odometry: OdometryResult, names: Sequence[str]) -> Tuple[i
     unheard = ", ".join(names[k] if k < len(names) else str(k) for k in odometry.unheard)
     heard = len(names) - len(odometry.unheard)
     if odometry.blind:
-        what = "along the last commanded motion" if heard else "none: zero twist, the pose held"
-        return ERROR, f"blind ({unheard} unheard): the wheels are stopped; the estimate from {heard} drive(s) {what}"
+        what = (
+            f"the estimate is the {heard} heard drive(s)' speed along the last commanded motion"
+            if heard
+            else "no drive heard: zero twist, the pose held"
+        )
+        return ERROR, f"blind ({unheard} unheard): the wheels are stopped; {what}"
     return WARN, f"degraded: from {heard} of {len(names)} drives ({unheard} unheard)"
 
 

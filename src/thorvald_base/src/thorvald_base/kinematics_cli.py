@@ -13,6 +13,8 @@ import sys
 from typing import List, Optional
 
 from thorvald_model import ConfigError, load_robot_config
+from thorvald_model.errors import UnknownRobotError
+from thorvald_model.examples import robot_file
 
 from .errors import ThorvaldBaseError
 from .kinematics import DriveLayer, DriveState, Twist
@@ -110,7 +112,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         description="Show the joint commands a robot configuration gives for a body twist, and the twist odometry "
         "recovers from them.",
     )
-    parser.add_argument("config", metavar="CONFIG", help="robot configuration file (YAML)")
+    parser.add_argument("config", metavar="ROBOT", help="an example robot's name or a robot configuration file (YAML)")
     parser.add_argument(
         "--twist", nargs=3, type=float, metavar=("VX", "VY", "WZ"), required=True, help="body twist [m/s m/s rad/s]"
     )
@@ -125,9 +127,12 @@ def main(argv: Optional[List[str]] = None) -> int:
     )
     args = parser.parse_args(argv)
     try:
-        config = load_robot_config(args.config)
+        config = load_robot_config(robot_file(args.config))
         report = compute(config, Twist(*args.twist), args.estimator, projection=args.projection)
     except ConfigError as e:
+        print(f"kinematics: {e}", file=sys.stderr)
+        return 2
+    except UnknownRobotError as e:
         print(f"kinematics: {e}", file=sys.stderr)
         return 2
     except ThorvaldBaseError as e:

@@ -183,3 +183,12 @@ def test_battery_state_and_io_messages():
     assert not gone.present and math.isnan(gone.capacity)
     io = conversions.io_array_msg(Time(2, 0), [IoInfo(3, 0, (True, False), (12.0, 5.0, 0.0), True)])
     assert io.ios[0].id == 3 and list(io.ios[0].relay_states) == [True, False] and io.ios[0].online
+
+
+def test_an_unheard_drives_speeds_are_nan_in_base_state_and_its_angles_the_last_heard():
+    heard = MeasuredDrive(0.1, 0.3, 2.0, 0.05)
+    silent = MeasuredDrive(0.2, 0.3, 4.0, 0.05, heard=False)
+    msg = conversions.state_msg(Time(1, 0), [heard, silent])
+    assert msg.prop_speed[0] == 0.3 and math.isnan(msg.prop_speed[1])
+    assert msg.steer_speed[0] == 0.05 and math.isnan(msg.steer_speed[1])
+    assert list(msg.steer_pos) == [0.1, 0.2] and list(msg.prop_pos) == [2.0, 4.0]

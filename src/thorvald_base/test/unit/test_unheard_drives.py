@@ -188,7 +188,16 @@ def test_diagnostics_and_the_log_say_what_odometry_rests_on():
     assert dict(status.values)["drives heard"] == "3 of 4"
     blind = OdometryResult(Twist(), Pose(), 0.0, 0.0, unheard=(0, 1, 2, 3), blind=True)
     (status,) = base_statuses("r1", [], [], {}, odometry=blind, drive_names=names)
-    assert status.level == ERROR and "blind" in status.message and "wheels are stopped" in status.message
+    assert status.level == ERROR and status.message == (
+        "blind (drive0, drive1, drive2, drive3 unheard): the wheels are stopped; "
+        "no drive heard: zero twist, the pose held"
+    )
+    one = OdometryResult(Twist(), Pose(), 0.0, 0.0, unheard=(1,), blind=True)
+    (status,) = base_statuses("r1", [], [], {}, odometry=one, drive_names=["drive0", "drive1"])
+    assert status.message == (
+        "blind (drive1 unheard): the wheels are stopped; the estimate is the 1 heard drive(s)' speed along the last "
+        "commanded motion"
+    )
 
     watch = OdometryWatch(names)
     starting = OdometryResult(Twist(), Pose(), 0.0, 0.0, unheard=(0, 1, 2, 3), blind=True)

@@ -139,7 +139,7 @@ def run(args) -> int:
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
     bag = os.path.join(out, BAG)
-    wall, _ = drive(args, model, bag, "calibration", args.side)
+    wall, _ = drive(args, model, bag, "calibration", args.side, log="calibration_drive")
     print(f"  drive: {wall:.1f} s wall; bag {bag}", flush=True)
     balance = args.balance if args.balance is not None else fights(config)
     # ROS's Python (rosbag) only now: --help and bad robots stay fast

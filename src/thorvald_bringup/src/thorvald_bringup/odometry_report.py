@@ -300,13 +300,14 @@ def _largest_gap(a: Path, b: Path) -> float:
     return gap
 
 
-def format_report(report: Report, targets: Optional[Tuple[float, float]] = None) -> str:
-    """The table printed by odometry_report; targets: (distance error [%], end point [m]) for lsq."""
+def format_report(report: Report, targets: Optional[Tuple[float, float]] = None, paper: bool = True) -> str:
+    """The table printed by odometry_report; targets: (distance error [%], end point [m]) for lsq; paper:
+    the drive is the paper's manoeuvre, beside whose figures it is printed (another drive is not)."""
     rec = report.recording
     f = report.figures
     truth = f["ground truth"]
     names = [n for n in ("ground truth", "odometry lsq", "odometry paper") if n in f]
-    head = f"{'':30}" + "".join(f"{n:>16}" for n in names) + f"{'the paper':>22}"
+    head = f"{'':30}" + "".join(f"{n:>16}" for n in names) + (f"{'the paper':>22}" if paper else "")
     paper_cols = {
         "distance [m]": f"{PAPER_TRUTH_DISTANCE:.1f} / {PAPER_ODOMETRY_DISTANCE:.1f}",
         "distance error [%]": f"{(PAPER_ODOMETRY_DISTANCE - PAPER_TRUTH_DISTANCE) / PAPER_TRUTH_DISTANCE * 100:+.1f}",
@@ -319,12 +320,13 @@ def format_report(report: Report, targets: Optional[Tuple[float, float]] = None)
         for n in names:
             value = getter(f[n])
             cells.append(f"{'-' if math.isnan(value) else format(value, fmt):>16}")
-        return f"  {label:28}" + "".join(cells) + f"{paper_cols[label]:>22}"
+        return f"  {label:28}" + "".join(cells) + (f"{paper_cols[label]:>22}" if paper else "")
 
+    duration = f" (the paper: about {PAPER_DURATION:.0f} s)" if paper else ""
     lines = [
         f"Odometry report: {rec.robot or 'robot'}" + (f" ({rec.source})" if rec.source else ""),
-        f"  manoeuvre {report.end - report.start:.1f} s from the first command (the paper: about "
-        f"{PAPER_DURATION:.0f} s); paths aligned at their start pose",
+        f"  manoeuvre {report.end - report.start:.1f} s from the first command{duration}; paths aligned at their "
+        "start pose",
         head,
         row("distance [m]", ".2f", lambda g: g.distance),
         row("distance error [%]", "+.2f", lambda g: g.distance_error),
@@ -332,8 +334,9 @@ def format_report(report: Report, targets: Optional[Tuple[float, float]] = None)
         row(
             "heading at the end [deg]", "+.2f", lambda g: math.nan if g is truth else math.degrees(g.heading_difference)
         ),
-        "  (the paper's column: RTK-GNSS / odometry of its six-wheeled robot on tarmac, Figures 8 and 9)",
     ]
+    if paper:
+        lines.append("  (the paper's column: RTK-GNSS / odometry of its six-wheeled robot on tarmac, Figures 8 and 9)")
     if not math.isnan(report.replay_agreement):
         lines.append(
             f"  odometry lsq replayed from base_state agrees with base_driver's odometry/base_raw within "

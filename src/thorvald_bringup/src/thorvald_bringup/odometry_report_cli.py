@@ -75,8 +75,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--out",
         metavar="DIR",
-        default="odometry_report",
-        help="where the bag and the figures go (default ./odometry_report)",
+        help="where the bag and the figures go (default ./odometry_report; with --bag, the bag's folder)",
     )
     p.add_argument(
         "--calibration",
@@ -245,7 +244,7 @@ def run(args) -> int:
         correction = read_calibration(args.calibration, config).odometry
     if not 1 <= args.physics_workers <= MAX_WORKERS:
         raise ThorvaldBringupError(f"--physics-workers: {args.physics_workers}: must be in 1..{MAX_WORKERS}")
-    out = os.path.abspath(args.out)
+    out = os.path.abspath(args.out or (os.path.dirname(os.path.abspath(args.bag)) if args.bag else "odometry_report"))
     os.makedirs(out, exist_ok=True)
     name = os.path.splitext(os.path.basename(model))[0]
     breaks = []
@@ -281,7 +280,7 @@ def run(args) -> int:
     if wall is not None or args.plan:
         report.planned_distance = commanded_path(plan_named(args.manoeuvre, config)[1])[1]
     print()
-    print(format_report(report, (TARGET_DISTANCE_ERROR, TARGET_END_POINT)))
+    print(format_report(report, (TARGET_DISTANCE_ERROR, TARGET_END_POINT), paper=args.manoeuvre == "verification"))
     if args.as_built:
         print(f"  as built ({args.as_built}): {describe_as_built(built)}")
     if wall is not None:

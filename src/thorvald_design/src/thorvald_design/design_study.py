@@ -90,9 +90,8 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"design_study: cannot reach the scheduler {args.scheduler}: {e}", file=sys.stderr)
         return 2
     print(
-        f"design_study: {len(study.candidates)} candidates x {len(study.scenarios)} scenarios = {len(jobs)} runs"
-        + (f" ({skipped} already in {args.out})" if skipped else "")
-        + f", {where}",
+        f"design_study: {counted(len(study.candidates), 'candidate')} x {counted(len(study.scenarios), 'scenario')} = "
+        f"{counted(len(jobs), 'run')}" + (f" ({skipped} already in {args.out})" if skipped else "") + f", {where}",
         file=sys.stderr,
     )
     started = time.monotonic()
@@ -120,6 +119,11 @@ def main(argv: Optional[List[str]] = None) -> int:
 SCHEDULER_TIMEOUT = 10.0  # [s] to reach a Dask scheduler
 
 
+def counted(n: int, one: str, many: str = "") -> str:
+    """n and the noun, plural unless n is 1: '1 scenario', '3 runs'."""
+    return f"{n} {one if n == 1 else (many or one + 's')}"
+
+
 def _executor(args, runs: int):
     """(a concurrent.futures executor, its workers, what it is): local worker processes (one pybullet
     client each, started fresh: spawn), or a Dask distributed scheduler's workers (its
@@ -132,7 +136,7 @@ def _executor(args, runs: int):
         return _DaskExecutor(client), workers, f"{workers} Dask workers at {args.scheduler}"
     workers = min(args.jobs or os.cpu_count() or 1, max(runs, 1))
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
-    return pool, workers, f"{workers} worker process{'' if workers == 1 else 'es'}"
+    return pool, workers, counted(workers, "worker process", "worker processes")
 
 
 class _DaskExecutor:

@@ -25,7 +25,8 @@ from typing import Dict, List, Optional
 from .check_report import report
 from .config import RobotConfig, load_robot_config
 from .description import XacroError, generate_urdf
-from .errors import ConfigError
+from .errors import ConfigError, UnknownRobotError
+from .examples import robot_file
 from .plugins import calculator_loader, calculator_problems
 
 
@@ -120,7 +121,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser = argparse.ArgumentParser(
         prog="check_config", description="Validate Thorvald robot configuration files and summarise the robots."
     )
-    parser.add_argument("files", nargs="+", metavar="FILE", help="robot configuration YAML file(s)")
+    parser.add_argument(
+        "files", nargs="+", metavar="ROBOT", help="robot configuration YAML file(s), or example robots' names"
+    )
     parser.add_argument("--json", action="store_true", help="print the summaries as JSON")
     parser.add_argument(
         "--model-extras",
@@ -136,8 +139,10 @@ def main(argv: Optional[List[str]] = None) -> int:
 
     configs, descriptions, failed = [], {}, 0
     calculators = calculator_loader()  # one search of the workspace's exports for every file
-    for path in args.files:
+    for given in args.files:
+        path = given
         try:
+            path = robot_file(given)  # an example robot's name, or a file
             config = load_robot_config(path)
             problems = calculator_problems(config, calculators)
             if problems:
@@ -152,6 +157,9 @@ def main(argv: Optional[List[str]] = None) -> int:
         except XacroError as e:  # e.g. an extras file that is missing or not XML
             failed += 1
             print(f"check_config: error: {path}: {e}", file=sys.stderr)
+        except UnknownRobotError as e:
+            failed += 1
+            print(f"check_config: {e}", file=sys.stderr)
 
     def row(config: RobotConfig) -> dict:
         out = summary(config)

@@ -82,6 +82,12 @@ def test_the_drives_follow_commands_through_the_bus(std):
     assert {r.mode for r in reports} == {3}
     assert {r.type for r in reports} == {"RoboteqFbl2360"} and {r.version for r in reports} == {"2.1.0"}
     assert reports[0].battery_volts > 40
+    # relative power in [-1, 1] (motor_controller_data's unit); TxPDO2 carries it in per mille, and the
+    # emulator reports the rim speed over the drive's top speed: 0.5 / 1.5 m/s
+    propulsion = reports[0].motor_vars[0]
+    assert propulsion[0] == "propulsion" and propulsion[4] == pytest.approx(
+        0.5 / config.drives[0].max_wheel_speed, abs=0.01
+    )
     (battery,) = handle.batteries(t)
     assert battery.state == 0 and 40 < battery.voltage < 60 and battery.state_of_charge > 90
 

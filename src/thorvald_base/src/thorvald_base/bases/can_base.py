@@ -461,17 +461,18 @@ class CanBase(BaseHandle):
             mode = MODE_LOST_CONNECTION if not c.online(time) else (MODE_HOME if self.homing else MODE_ONLINE)
             measured = c.measured()
             amps = c.tx2.amps if c.tx2 else (0.0, 0.0)
-            power = c.tx2.power if c.tx2 else (0, 0)
+            # TxPDO2 reports it in per mille; motor_controller_data's relative_power is in [-1, 1]
+            power = tuple(p / 1000.0 for p in c.tx2.power) if c.tx2 else (0.0, 0.0)
             if c.steered:
                 steering, rate, speed = measured[0]
                 k = c.indices[0]
                 motor_vars = (
-                    ("propulsion", speed, self.wheel_angles[k], amps[0], float(power[0])),
-                    ("steering", rate, steering, amps[1], float(power[1])),
+                    ("propulsion", speed, self.wheel_angles[k], amps[0], power[0]),
+                    ("steering", rate, steering, amps[1], power[1]),
                 )
             else:
                 motor_vars = tuple(
-                    ("propulsion", m[2], self.wheel_angles[k], amps[i], float(power[i]))
+                    ("propulsion", m[2], self.wheel_angles[k], amps[i], power[i])
                     for i, (k, m) in enumerate(zip(c.indices, measured))
                 )
             version = c.script.version if c.script else ""
