@@ -44,6 +44,7 @@ def assert_steps_bounded(driven):
         assert np.max(np.abs(np.log(np.asarray(b) / np.asarray(a)))) <= MAX_STEP + 1e-12
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_a_balance_finds_each_tyres_radius_and_drives_only_bounded_steps():
     config = load_robot_config(ASYM)
     balancer = Balancer(config, kinds(config))

@@ -65,6 +65,7 @@ def test_every_parameter_recovered_exactly_without_noise(ground_truth):
     assert calibration.turned == pytest.approx(6.7, abs=1e-9)  # 0.35*6 + 0.2*5 + 0.6*3 + 0.3*6 [rad]
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 @pytest.mark.parametrize("ground_truth", GROUND_TRUTHS)
 def test_the_values_in_effect_are_where_the_estimates_start_from(ground_truth):
     """base_driver read the drive with drive1 at 0.205 m and drive2 homed 0.01 rad off: the estimates
@@ -89,6 +90,7 @@ NOISE = {
 }
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 @pytest.mark.parametrize("ground_truth", GROUND_TRUTHS)
 def test_with_noise_every_estimate_lies_within_three_standard_uncertainties(ground_truth):
     config = four_ws()
@@ -128,6 +130,7 @@ def test_the_stated_uncertainties_are_the_spread_of_the_estimates(ground_truth):
     assert np.mean(np.abs(z) < 2.0) > 0.85
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_a_straight_line_with_gnss_refuses_the_steering_offsets():
     """A straight line cannot tell a steering offset from a heading: δ_i + c and ψ − c fit alike."""
     config = four_ws()
@@ -219,6 +222,7 @@ def test_a_recording_of_another_robot_is_refused():
         DriveRecording.from_samples([(0.0, (0.0, 0.0), (0.1, 0.1))], 4)
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_odometry_error_before_and_after_on_a_straight_drive_with_larger_wheels():
     """Every wheel 1 % larger than configured: odometry reads 1/1.01 of the distance, -0.990 %, and
     the end point falls short by 0.0099 of the 30 m; calibrated, it reads the distance exactly."""
@@ -235,6 +239,7 @@ def test_odometry_error_before_and_after_on_a_straight_drive_with_larger_wheels(
     assert abs(after.distance_error_percent) < 1e-9 and after.end_point_m < 1e-9
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 @pytest.mark.parametrize("ground_truth", GROUND_TRUTHS)
 def test_the_calibrated_odometry_follows_ground_truth(ground_truth):
     config = four_ws()

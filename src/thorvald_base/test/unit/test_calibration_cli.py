@@ -82,6 +82,7 @@ def run(capsys, *args):
     return status, out, err
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_json_with_the_simulators_ground_truth(tmp_path, capsys, std):
     bag = write_bag(tmp_path / "drive.bag", synthetic_drive(std, MIXED, RADII, OFFSETS))
     status, out, err = run(capsys, bag, "--robot-model", STD, "--json")
@@ -106,6 +107,7 @@ def test_json_with_the_simulators_ground_truth(tmp_path, capsys, std):
     )
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_it_says_what_the_drive_determines_through_the_odometry_and_fits_only_that(tmp_path, capsys, std):
     bag = write_bag(tmp_path / "straight.bag", synthetic_drive(std, STRAIGHT, RADII, OFFSETS))
     status, out, err = run(capsys, bag, "--robot-model", STD)
@@ -135,6 +137,7 @@ def test_a_recording_that_lost_drive_states_is_refused(tmp_path, capsys, std):
     assert "the recording is incomplete (/robot_1/base_state: 1 lost, the first seq 100)" in err
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_text_with_gnss_on_a_straight_line_refuses_the_offsets(tmp_path, capsys, std):
     drive = synthetic_drive(std, STRAIGHT, RADII, OFFSETS, heading_bias=1.2, antenna=(0.3, 0.0))
     bag = write_bag(tmp_path / "straight.bag", drive, ns="", gnss=True)
@@ -159,6 +162,7 @@ def test_text_with_gnss_on_a_straight_line_refuses_the_offsets(tmp_path, capsys,
     assert "steering_offset" not in data.split("motor_drives:")[1]  # only what was estimated
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_a_calibration_in_effect_is_where_it_starts_and_what_it_keeps(tmp_path, capsys, std):
     earlier = tmp_path / "earlier.yaml"
     earlier.write_text("motor_drives:\n  drive1: {r_wheel: 0.205}\n  drive2: {steering_offset: 0.01}\n")
@@ -182,6 +186,7 @@ def test_a_calibration_in_effect_is_where_it_starts_and_what_it_keeps(tmp_path, 
     assert "kept from" in (tmp_path / "calibration.yaml").read_text()
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_fit_scale_takes_the_radii_common_factor_from_straight_legs_over_the_calibration_in_effect(
     tmp_path, capsys, std
 ):
@@ -219,6 +224,7 @@ def test_fit_scale_takes_the_radii_common_factor_from_straight_legs_over_the_cal
         assert status == 2 and err.count("\n") == 1 and message in err, err
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_fit_straight_also_takes_odometrys_yaw_per_metre_from_the_legs_heading(tmp_path, capsys, std):
     from thorvald_base.calibration.calibration_file import read_calibration  # noqa: PLC0415
     from thorvald_base.verification import plan_named  # noqa: PLC0415
@@ -242,6 +248,7 @@ def test_fit_straight_also_takes_odometrys_yaw_per_metre_from_the_legs_heading(t
     assert "each leg's heading change [deg], ground truth / odometry before / after: +0.00 / " in out
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_fit_turns_takes_the_yaw_rate_multiplier_from_the_turns_over_the_calibration_in_effect(tmp_path, capsys, std):
     from calibration_test_helpers import with_turn_slip  # noqa: PLC0415
 
@@ -304,6 +311,7 @@ def test_a_bag_that_cannot_calibrate_is_one_line_and_status_2(tmp_path, capsys, 
     assert not (tmp_path / "calibration.yaml").exists()
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_a_drive_that_excites_nothing_and_a_bad_robot_file_are_refused(tmp_path, capsys, std):
     standing = write_bag(tmp_path / "s.bag", synthetic_drive(std, ((5.0, Twist()),), RADII, OFFSETS))
     status, out, err = run(capsys, standing, "--robot-model", STD)

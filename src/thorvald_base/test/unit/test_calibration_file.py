@@ -30,6 +30,7 @@ def problems_of(data, config=None):
     return [(p.path, p.value, p.rule) for p in info.value.problems]
 
 
+@pytest.mark.slow  # a calibration file written and loaded as base_driver loads it
 def test_written_and_read_back_as_base_driver_reads_it(tmp_path):
     config = four_ws()
     drive = synthetic_drive(config, MIXED, RADII, OFFSETS)

@@ -69,6 +69,7 @@ DIAGONAL_RADII = {"drive0.r_wheel": 1.0, "drive2.r_wheel": 1.0, "drive1.r_wheel"
 DIAGONAL_OFFSETS = {n.replace("r_wheel", "steering_offset"): w for n, w in DIAGONAL_RADII.items()}
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_a_straight_line_determines_the_common_scale_the_crab_and_one_mixture_of_the_rest():
     config = four_ws()
     drive = synthetic_drive(config, STRAIGHT, RADII, OFFSETS)
@@ -86,6 +87,7 @@ def test_a_straight_line_determines_the_common_scale_the_crab_and_one_mixture_of
         assert c.strength < 1e-9 and c.sd == pytest.approx(1.0)
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_a_drive_that_turns_crabs_and_spins_determines_all_but_the_frames_diagonals():
     config = four_ws()
     drive = synthetic_drive(config, MIXED, RADII, OFFSETS)
@@ -111,6 +113,7 @@ def test_a_drive_that_turns_crabs_and_spins_determines_all_but_the_frames_diagon
         assert v @ found == pytest.approx(v @ truth, abs=0.02)  # first order in the priors' units
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_a_differential_robot_has_no_offsets_and_a_straight_line_determines_both_radii():
     config = diff()
     drive = synthetic_drive(config, DIFF_DRIVE[:1], (0.202, 0.199), (0.0, 0.0))
@@ -121,6 +124,7 @@ def test_a_differential_robot_has_no_offsets_and_a_straight_line_determines_both
     assert fit.value("drive1.r_wheel") == pytest.approx(0.199, rel=1e-6)
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_noise_leaves_a_stated_uncertainty_and_a_weak_combination_partly_at_its_prior():
     config = four_ws()
     noise = {"twist": 0.02, "speed": 0.005, "steering": 0.002}
@@ -139,6 +143,7 @@ def test_noise_leaves_a_stated_uncertainty_and_a_weak_combination_partly_at_its_
     assert np.std(scale) < 0.0005 and abs(np.mean(scale) - np.mean(RADII)) < 0.0005
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_a_drive_that_never_moves_or_of_another_robot_is_refused():
     config = four_ws()
     still = synthetic_drive(config, ((5.0, Twist()),), RADII, OFFSETS)
@@ -151,6 +156,7 @@ def test_a_drive_that_never_moves_or_of_another_robot_is_refused():
     assert math.isfinite(observable_fit(config, drive.recording, drive.pose_truth).sigma)
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_a_fit_that_moves_parameters_far_beyond_their_priors_says_so():
     config = four_ws()
     drive = synthetic_drive(config, MIXED, RADII, OFFSETS)
@@ -162,6 +168,7 @@ def test_a_fit_that_moves_parameters_far_beyond_their_priors_says_so():
     assert set(RADIUS) <= set(far) and all(far[n] < -10 for n in RADIUS)
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_the_balance_moves_the_fit_only_along_what_the_drive_did_not_determine():
     """along_undetermined: the fit moved towards the balance's radii and, after a toe search, its steering
     offsets, along the combinations the drive did not determine: every determined one keeps the fit's

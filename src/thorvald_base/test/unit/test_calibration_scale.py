@@ -23,6 +23,7 @@ def straight_drive(config, radii, offsets=None, **kw):
     return synthetic_drive(config, [(s.duration, s.twist) for s in plan], radii, offsets, **kw)
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_tyres_all_larger_by_one_factor_give_that_factor_and_the_offsets_are_kept():
     config = robot_config(SIX)
     radii = [d.r_wheel * 1.0042 for d in config.drives]
@@ -51,6 +52,7 @@ def test_from_gnss_with_noise_the_standstills_average_it_out():
     assert 0.0 < fit.sd < 0.001 and abs(fit.factor - 0.996) < 4 * fit.sd
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_different_tyres_give_their_common_motion_and_a_turning_drive_is_refused():
     config = robot_config(SIX)
     radii = [d.r_wheel * f for d, f in zip(config.drives, (1.01, 0.99, 1.0, 1.003, 0.997, 1.002))]
@@ -76,6 +78,7 @@ def test_a_leg_that_turned_is_left_out():
     assert fit.factor == pytest.approx(1.01, abs=1e-9) and math.isfinite(fit.sd)
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_radii_that_differ_side_to_side_read_a_turn_on_straight_legs_which_yaw_per_metre_takes_out():
     config = robot_config(SIX)
     lateral = np.array([d.y for d in config.drives])
@@ -107,6 +110,7 @@ def test_radii_that_differ_side_to_side_read_a_turn_on_straight_legs_which_yaw_p
     assert np.max(np.abs(yaw - yaw[0])) < math.radians(0.002)
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_yaw_per_metre_from_the_imus_yaw_and_one_beyond_a_calibration_is_refused():
     config = four_ws()
     lateral = [d.y for d in config.drives]

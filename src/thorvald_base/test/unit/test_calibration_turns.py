@@ -43,6 +43,7 @@ def test_the_turns_manoeuvre_turns_u_turns_of_the_field_routes_radius_both_ways_
         assert all(abs(s.twist.vx / s.twist.wz) == pytest.approx(ROW_SPACING / 2) for s in turns)
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_the_multiplier_is_ground_truths_turn_over_odometrys_and_the_turns_both_ways_average():
     config = robot_config(SIX)
     drive = with_turn_slip(turns_drive(config), left=1.004, right=1.008)
@@ -74,6 +75,7 @@ def test_the_multiplier_is_ground_truths_turn_over_odometrys_and_the_turns_both_
     assert before.end_point_m > 0.1 and after.end_point_m < 1e-3
 
 
+@pytest.mark.slow  # a fit or a replay of a whole synthetic drive
 def test_the_imus_yaw_is_ground_truth_enough_and_a_drive_without_turns_is_refused():
     config = four_ws()
     drive = with_turn_slip(turns_drive(config), left=1.005, right=1.005)

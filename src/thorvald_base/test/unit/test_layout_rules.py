@@ -84,6 +84,7 @@ def test_one_wheel_calculator_needs_fixed_wheels():
     assert_problem(robot, "base_calculator", "needs fixed passive wheels")
 
 
+@pytest.mark.slow  # every example robot's layout checked
 def test_one_wheel_drive_must_not_stand_on_the_axle():
     assert_problem(one_wheel_robot(drive_x=-0.4), "motor_drives.drive0", "axle line")
 

@@ -117,6 +117,7 @@ def test_the_plugin_loader_searches_the_workspace():
     assert "pltf_clc_std::PltfClcStd" in CalculatorLoader().known_names()
 
 
+@pytest.mark.slow  # a fresh interpreter per core, importing every module
 def test_no_pure_module_imports_the_ros_runtime_even_inside_a_function():
     """An import inside a function escapes the import-time check above: the source is read instead.
     Importing a module of NOT_PURE (e.g. conversions) counts as importing what it imports; the

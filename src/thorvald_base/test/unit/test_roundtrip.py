@@ -39,6 +39,7 @@ def assert_twist(got, vx, vy, wz, tol, *, reach=1.0):
     assert got.wz == pytest.approx(wz, abs=tol * scale + STOPPED_SPEED / reach)
 
 
+@pytest.mark.slow  # hypothesis: 100 twists on every example robot
 @pytest.mark.parametrize("estimator, tol", [("lsq", 1e-9), ("paper", 1e-6)])
 @pytest.mark.parametrize("robot_id", ROBOT_IDS)
 @settings(max_examples=100, deadline=None)
@@ -58,6 +59,7 @@ def test_odometry_recovers_realisable_twist(robot_id, estimator, tol, vx, vy, wz
         assert odom.residual < 1e-9 * (1 + abs(vx) + abs(vy) + abs(wz))
 
 
+@pytest.mark.slow  # hypothesis: 100 twists on every example robot
 @pytest.mark.parametrize("robot_id", ROBOT_IDS)
 @settings(max_examples=60, deadline=None)
 @given(vx=SPEED, vy=SPEED, wz=RATE, measured=st.lists(ANGLE, min_size=20, max_size=20))

@@ -82,6 +82,7 @@ def poses(plan, step=0.01):
     return out
 
 
+@pytest.mark.slow  # a manoeuvre's plan, replayed or fitted, for every example robot
 @pytest.mark.parametrize("path", EXAMPLE_ROBOTS, ids=lambda p: os.path.basename(p)[:-5])
 def test_the_calibration_drive_ends_where_it_started_within_its_area_every_twist_realisable(path):
     config = load_robot_config(path)
@@ -105,6 +106,7 @@ def test_the_calibration_drive_ends_where_it_started_within_its_area_every_twist
         assert any(s.twist.vx == s.twist.vy == 0 and s.twist.wz < 0 for s in plan)
 
 
+@pytest.mark.slow  # a manoeuvre's plan, replayed or fitted, for every example robot
 @pytest.mark.parametrize("make", [four_ws, diff, four_wd_two_ws], ids=["4ws", "diff", "4wd2ws"])
 def test_the_calibration_drive_determines_every_combination_any_drive_can(make):
     """What a long drive of random twists (every direction the robot can move in, for minutes)
@@ -161,6 +163,7 @@ def test_the_field_route_is_rows_and_headland_turns_of_about_the_papers_length(p
             assert abs(cmd.speed) <= d.max_wheel_speed, (seg.label, d.name)
 
 
+@pytest.mark.slow  # a manoeuvre's plan, replayed or fitted, for every example robot
 @pytest.mark.parametrize("path", EXAMPLE_ROBOTS, ids=lambda p: os.path.basename(p)[:-5])
 def test_the_balancing_drive_is_straight_legs_both_ways_every_wheel_straight_at_one_speed(path):
     config = load_robot_config(path)
@@ -192,6 +195,7 @@ def test_the_balancing_drive_is_straight_legs_both_ways_every_wheel_straight_at_
         assert twist_at(plan, end + 0.5) == twist_at(plan, end + 2.5)  # standing: the pause
 
 
+@pytest.mark.slow  # a manoeuvre's plan, replayed or fitted, for every example robot
 @pytest.mark.parametrize("path", EXAMPLE_ROBOTS, ids=lambda p: os.path.basename(p)[:-5])
 def test_the_straight_drive_is_legs_on_one_line_with_stops_every_wheel_straight(path):
     config = load_robot_config(path)

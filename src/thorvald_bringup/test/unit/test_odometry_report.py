@@ -31,6 +31,7 @@ def asym():
     return robot()
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_a_perfect_drive_reports_no_error_whatever_frames_the_paths_start_in(asym):
     rec = synthetic(asym, SQUARE_AND_CIRCLE, truth_origin=(4.0, -2.0, 1.2), odom_origin=(-7.0, 3.0, -2.5))
     report = make_report(rec, calculators(asym))
@@ -50,6 +51,7 @@ def test_a_perfect_drive_reports_no_error_whatever_frames_the_paths_start_in(asy
     assert report.replay_agreement < 1e-9
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_wheels_two_percent_too_big_give_plus_two_percent_and_the_end_point_ahead(asym):
     rec = synthetic(asym, [(Twist(1.0, 0.0, 0.0), 10.0)], wheel_scale=1.02)
     report = make_report(rec, calculators(asym))
@@ -70,6 +72,7 @@ def test_the_window_runs_from_the_first_command_to_rest_seconds_after_the_last(a
     assert report.paths["ground truth"].t[-1] <= report.end
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_the_paper_estimator_is_replayed_from_the_same_drive_states_as_lsq(asym):
     # The drive states say the robot spins; base_driver's published odometry (here: nonsense) is not used for paper.
     rec = synthetic(asym, [(Twist(0.0, 0.0, 0.5), 6.0)])
@@ -93,6 +96,7 @@ def test_path_length_and_alignment():
     assert aligned(p, 1.5, 3.0).t[0] == 1.5  # a start between samples gets the pose before it
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_a_recording_without_motion_or_topics_is_refused_with_the_reason(asym):
     rec = synthetic(asym, [(Twist(1.0, 0.0, 0.0), 2.0)])
     still = Recording([(1.0, 0.0, 0.0, 0.0)], rec.truth, rec.odometry, rec.states)
@@ -107,6 +111,7 @@ def test_a_recording_without_motion_or_topics_is_refused_with_the_reason(asym):
         make_report(late, calculators(asym))
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_a_topic_recorded_only_after_the_manoeuvre_started_is_refused(asym):
     # rosbag connected to ground truth 0.6 s into the drive: aligned at its first sample, ground truth
     # would lack its first metres (a CI run reported +1.05 % for that)
@@ -122,6 +127,7 @@ def test_a_topic_recorded_only_after_the_manoeuvre_started_is_refused(asym):
         make_report(Recording(rec.commands, rec.truth, rec.odometry, states), calculators(asym, ("lsq",)))
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_the_table_puts_both_estimators_beside_the_papers_figures_and_judges_the_targets(asym):
     report = make_report(synthetic(asym, [(Twist(1.0, 0.0, 0.0), 10.0)], wheel_scale=1.01), calculators(asym))
     text = format_report(report, (0.5, 1.0))
@@ -136,6 +142,7 @@ def test_the_table_puts_both_estimators_beside_the_papers_figures_and_judges_the
     assert format_report(good, (0.5, 1.0)).endswith("end point < 1 m: met")
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_drive_states_missing_from_the_recording_are_counted_beside_the_replay_agreement(asym):
     rec = synthetic(asym, [(Twist(1.0, 0.0, 0.5), 4.0)])
     assert make_report(rec, calculators(asym, ("lsq",))).missing_states == 0
@@ -145,6 +152,7 @@ def test_drive_states_missing_from_the_recording_are_counted_beside_the_replay_a
     assert "(3 base_state messages missing from the recording)" in format_report(report)
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_a_drive_short_of_its_plan_is_flagged(asym):
     report = make_report(synthetic(asym, [(Twist(1.0, 0.0, 0.0), 10.0)]), calculators(asym, ("lsq",)))
     assert "plan" not in format_report(report)  # a recording of any drive: no plan to compare with
@@ -197,6 +205,7 @@ def test_gnss_fixes_map_back_to_the_world_as_hector_made_them():
     assert hector_fix(100.0, 0.0)[0] > LAT0 and hector_fix(0.0, 100.0)[1] < LON0
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_odometry_against_rtk_gnss_as_the_paper_measured(asym):
     rec = with_gnss(synthetic(asym, SQUARE_AND_CIRCLE, wheel_scale=1.02, truth_origin=(4.0, -2.0, 0.7)), noise=0.0)
     report = make_report(rec, calculators(asym))
@@ -217,6 +226,7 @@ def test_odometry_against_rtk_gnss_as_the_paper_measured(asym):
     assert "against RTK-GNSS" in text and "RTK-GNSS" in text.splitlines()[-6]
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_rtk_noise_does_not_inflate_the_gnss_distance(asym):
     rec = with_gnss(synthetic(asym, [(Twist(1.0, 0.0, 0.0), 20.0)]), noise=0.02)
     report = make_report(rec, calculators(asym))
@@ -230,6 +240,7 @@ def test_rtk_noise_does_not_inflate_the_gnss_distance(asym):
     assert report.figures_gnss["odometry lsq"].end_point_difference < 0.08  # 2 cm noise, both ends
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_a_recording_without_gnss_reports_ground_truth_only(asym):
     report = make_report(synthetic(asym, SQUARE_AND_CIRCLE), calculators(asym))
     assert report.figures_gnss == {} and "RTK-GNSS" not in report.paths

@@ -58,6 +58,7 @@ def drive():
     return synthetic(robot(), LEGS, wheel_scale=1.01, truth_origin=(3.0, 1.0, 0.5))
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_a_bag_reads_back_as_the_drive_that_was_recorded(tmp_path, drive):
     write_bag(tmp_path / "drive.bag", drive)
     rec = read_recording(str(tmp_path / "drive.bag"), robot="asym")
@@ -75,6 +76,7 @@ def test_a_bag_reads_back_as_the_drive_that_was_recorded(tmp_path, drive):
     assert [s[1:] for s in rec.states] == [s[1:] for s in drive.states]
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_a_bag_without_a_needed_topic_is_refused_naming_it(tmp_path, drive):
     write_bag(tmp_path / "no_truth.bag", drive, skip=("odometry/gazebo",))
     with pytest.raises(
@@ -88,6 +90,7 @@ def test_a_bag_without_a_needed_topic_is_refused_naming_it(tmp_path, drive):
         read_recording(str(tmp_path / "junk.bag"))
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_a_recording_that_lost_a_message_the_report_reads_is_refused_naming_it(tmp_path, drive):
     write_bag(tmp_path / "whole.bag", drive)
     check_complete(read_recording(str(tmp_path / "whole.bag")))  # every message, numbered in order
@@ -148,6 +151,7 @@ def test_odometry_report_refuses_a_bag_of_another_robot_and_a_bad_robot_with_one
     assert not os.path.exists(tmp_path / "figure8_paths.png")
 
 
+@pytest.mark.slow  # a report of a whole recorded drive
 def test_odometry_report_refuses_a_calculator_it_cannot_load_as_a_problem_of_the_robot_file(tmp_path, drive, capsys):
     """The bag reads, then the robot's calculator cannot be loaded: the robot file's problem, exit 2."""
     from thorvald_bringup.odometry_report_cli import main  # noqa: PLC0415

@@ -25,6 +25,7 @@ def tricycle():
     return design_of(TRICYCLE, package_file("config", TRICYCLE, TRICYCLE + ".yaml"))
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 def test_the_simulated_robots_centre_of_mass_is_the_descriptions(tricycle):
     """Measured in the simulator: where the description has it (pybullet's merge of fixed links put it
     3.9 cm higher until the simulator loaded each merged link's mass at its centre)."""

@@ -25,6 +25,7 @@ def robot_file(name):
     return package_file("config", name, name + ".yaml")
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 @pytest.mark.parametrize("name", [SIX, NINE])
 def test_on_soft_ground_a_rigid_frame_shares_its_weight_as_the_linear_model_says(name):
     design = design_of(name, robot_file(name))

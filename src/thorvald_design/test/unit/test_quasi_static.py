@@ -224,6 +224,7 @@ def test_rolling_resistance_lowers_the_rear_drives_climb_as_its_closed_form_says
     assert gradeability(two_axle("fr"), mu, c_rr).descent == pytest.approx(math.atan(mu), abs=TOL)
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 def test_rolling_the_loads_act_ahead_of_the_contacts_and_the_climb_tips_that_much_sooner():
     # rolling forward, each load acts e ahead of its contact (the rolling resistance's moment): the
     # centre of pressure lies e further back, so the rear axle carries W e / L more on level ground,
@@ -403,6 +404,7 @@ def test_bad_input_is_refused_with_a_clear_message(call, message):
 EXAMPLES = sorted(os.path.basename(os.path.dirname(p)) for p in glob.glob(os.path.join(ROBOTS, "*", "*.yaml")))
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 @pytest.mark.parametrize("name", EXAMPLES)
 def test_an_example_robots_layout_is_its_configurations_wheels_and_its_descriptions_mass(name):
     config = load_robot_config(robot_file(name))
@@ -417,6 +419,7 @@ def test_an_example_robots_layout_is_its_configurations_wheels_and_its_descripti
     gradeability(layout, 0.9, 0.015)
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 def test_the_one_wheel_drives_drive_one_contact_front_or_rear_on_three():
     fwd, rwd = load_layout(robot_file("thorvald_ii_1wd1ws_fwd")), load_layout(robot_file("thorvald_ii_1wd1ws_rwd"))
     for layout, sign in ((fwd, 1.0), (rwd, -1.0)):
@@ -426,6 +429,7 @@ def test_the_one_wheel_drives_drive_one_contact_front_or_rear_on_three():
         assert all(c.x * sign < 0.0 for c in layout.contacts if not c.driven)
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 def test_a_chosen_set_of_drives_drives_and_an_unknown_name_is_refused():
     config = load_robot_config(robot_file("thorvald_ii_4wd4ws_std"))
     urdf = generate_urdf(robot_file("thorvald_ii_4wd4ws_std"))
@@ -436,6 +440,7 @@ def test_a_chosen_set_of_drives_drives_and_an_unknown_name_is_refused():
         layout_of(config, urdf, driven={"drive9"})
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 def test_the_one_wheel_drives_climb_less_than_the_four_wheel_drive_and_front_drive_grips_least():
     mu, c_rr = 0.9, 0.015
     fwd, rwd, std = (

@@ -37,6 +37,7 @@ class NoLab:
         raise AssertionError("a robot the scenario cannot drive is not simulated")
 
 
+@pytest.mark.slow  # a design built from a robot file and its description
 def test_a_robot_without_rail_wheels_gets_no_metric():
     result = RAILS.procedure(NoLab(), example("thorvald_ii_4wd4ws_std"), PARAMS)
     assert result == {name: "n/a: its drives have no rail wheels" for name in RESULTS}

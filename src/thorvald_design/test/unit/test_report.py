@@ -434,6 +434,7 @@ def disagreeing_study(step):
     return study, results
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 def test_the_page_says_where_a_limit_and_its_prediction_disagree_beyond_the_step_and_not_otherwise(tmp_path):
     study, results = disagreeing_study(2.0)
     with open(write_report(str(tmp_path / "two"), results, study), encoding="utf-8") as f:
@@ -483,6 +484,7 @@ def test_write_report_twice_gives_the_same_bytes(made_report, tmp_path):
     }
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 def test_write_report_of_one_scenario_without_pictures_tracks_or_pareto(tmp_path):
     """The quick one (two plots): what a study without the runs' pictures and tracks gets, twice the same."""
     study, results = made_study()

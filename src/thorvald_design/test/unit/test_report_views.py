@@ -164,6 +164,7 @@ def test_without_the_simulated_robots_figures_the_sentence_gives_the_scenarios_o
     assert "(The robot as simulated, its centre of mass and rolling resistance: 15.3 deg.)" in text
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 def test_the_comparison_chart_draws_measured_and_predicted_on_one_chart_and_marks_the_disagreement(tmp_path):
     climb = comparisons(results_of(), study_of(STEP2))[0]
     with matplotlib.rc_context(RC):
@@ -213,6 +214,7 @@ def test_a_spins_wheel_path_is_a_circle_about_the_spot_of_the_turning_diameter()
     assert turn_view(parse_tracks({"tracks": [dict(spin_drive(), marks={})]}).drives[0]) is None
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 def test_the_turning_plot_carries_both_circles_the_wheel_path_and_both_diameters(tmp_path):
     tracks = parse_tracks({"tracks": [spin_drive(), spin_drive("turn right", -1.0)]})
     turns = [turn_view(d) for d in tracks.drives]
@@ -348,6 +350,7 @@ def test_a_steps_and_a_side_slopes_profiles():
     assert try_text(one) == "20°: ok, 5.0 m along"
 
 
+@pytest.mark.slow  # the statics or the report of every example robot, or a plot
 def test_the_side_view_draws_a_panel_a_series_and_says_how_far_each_try_got(tmp_path):
     drives = [climb(a, "ok", [-1.0 + 0.2 * k for k in range(40)]) for a in (6.0, 8.0, 10.0)]
     drives.append(climb(12.0, "tipping", [-1.0 + 0.2 * k for k in range(12)]))

@@ -42,6 +42,7 @@ def test_a_study_names_its_candidates_and_its_scenarios_with_their_defaults():
     assert dict(s.scenarios)["turning"]["speed"] == pytest.approx(2.0 / 3.6)
 
 
+@pytest.mark.slow  # every combination's robot file loaded and checked
 def test_a_sweep_is_one_candidate_a_combination_and_star_keeps_each_entrys_sign():
     s = study(
         """
@@ -217,6 +218,7 @@ def test_the_refusal_names_the_study_file_and_nothing_is_made(tmp_path, caplog):
          "(y=0.6): names keep 6 significant digits"),
     ],
 )  # fmt: skip
+@pytest.mark.slow  # every combination's robot file loaded and checked
 def test_a_sweep_whose_combinations_make_the_same_robot_is_refused(robot, sweep, expected):
     text = problems(f"candidates: {{a: {{robot: {robot}, sweep: {sweep}}}}}\nscenarios: {{turning: {{}}}}")
     assert expected in text and "1 problem)" in text
@@ -239,6 +241,7 @@ def test_swept_integers_and_flags_are_written_as_the_file_writes_them():
     assert drive0 == 2048 and isinstance(drive0, int)
 
 
+@pytest.mark.slow  # every combination's robot file loaded and checked
 def test_a_searched_range_that_changes_nothing_is_refused():
     """A range no sweep expands: its min and max, the other key paths at their first, must differ."""
     text = problems(
@@ -309,6 +312,7 @@ def test_drawbar_takes_one_surface_or_several_and_each_has_its_columns():
 STUDIES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "studies")
 
 
+@pytest.mark.slow  # every combination's robot file loaded and checked
 @pytest.mark.parametrize("name", sorted(f for f in os.listdir(STUDIES) if f.endswith(".yaml")))
 def test_every_shipped_study_is_a_valid_study_with_its_command_in_its_header(name):
     path = os.path.join(STUDIES, name)

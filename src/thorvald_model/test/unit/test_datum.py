@@ -52,6 +52,7 @@ def test_the_datum_is_written_into_the_simulator_block(tmp_path):
     assert ET.fromstring(generate_urdf(STD)).find("gazebo/plugin/datum") is None
 
 
+@pytest.mark.slow  # a description generated through xacro
 def test_a_broken_datum_file_stops_the_model_with_the_loaders_message(tmp_path):
     path = tmp_path / "datum.yaml"
     path.write_text("datum: [95, 0, 0]\n")

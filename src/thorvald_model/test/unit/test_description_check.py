@@ -46,6 +46,7 @@ def test_extras_written_with_a_leading_slash_attach_to_the_robots_links(tf_prefi
     assert tree.find(f"gazebo[@reference='{prefix}lidar_link']") is not None
 
 
+@pytest.mark.slow  # a description generated through xacro for every example robot
 def test_an_extras_joint_naming_a_missing_link_stops_generation_naming_joint_link_and_closest():
     with pytest.raises(UrdfCheckError) as info:
         generate_urdf(STD, model_extras=MISSING_LINK)
@@ -115,6 +116,7 @@ def test_check_config_reports_the_extras_problems_and_exits_2(capsys):
     assert f"{MISSING_LINK}: {MISSING_LINE}" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # a description generated through xacro for every example robot
 def test_check_config_summarises_the_checked_description(capsys):
     assert check_config([STD, "--model-extras", SLASHED, "--tf-prefix", "thorvald_001/"]) == 0
     out = capsys.readouterr().out

@@ -40,6 +40,7 @@ def names(urdf):
     return sorted(e.get("name") for e in tree if e.tag in ("link", "joint"))
 
 
+@pytest.mark.slow  # a description generated through xacro for every example robot
 @pytest.mark.parametrize("config", [STD, DIFF], ids=["std", "diff"])
 def test_both_conventions_give_one_description(config):
     newer = generate_urdf(config, tf_prefix="thorvald_001/", robot_name="thorvald_001")

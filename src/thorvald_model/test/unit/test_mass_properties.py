@@ -79,6 +79,7 @@ def test_a_description_without_a_mass_or_one_root_is_refused(urdf, says):
         mass_properties(urdf)
 
 
+@pytest.mark.slow  # a description generated through xacro for every example robot
 @pytest.mark.parametrize("path", EXAMPLE_ROBOTS, ids=robot_id)
 def test_every_example_robot_has_the_mass_of_its_inertial_blocks_centred_between_its_wheels(path):
     text = urdf_text(path)

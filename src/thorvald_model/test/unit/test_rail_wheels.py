@@ -186,6 +186,7 @@ def test_the_wheel_link_carries_the_rail_wheels_tread_between_two_flanges():
         ]
 
 
+@pytest.mark.slow  # a description generated through xacro for every example robot
 def test_a_robot_without_rail_wheels_is_described_as_before(tmp_path):
     """Rail keys at their defaults, written out or not, change nothing of the description (the
     goldens of test_urdf.py hold every example robot to it)."""

@@ -95,6 +95,7 @@ def extras_file(tmp_path, body: str) -> str:
 
 
 # --- the example on the standard robot ------------------------------------------------------------
+@pytest.mark.slow  # a description generated through xacro for every example robot
 @PREFIXES
 def test_the_example_fits_each_sensor_on_a_fixed_joint(prefix):
     root = tree(prefix=prefix)
@@ -228,6 +229,7 @@ def joint_to(root: ET.Element, child: str) -> ET.Element:
     return found[0]
 
 
+@pytest.mark.slow  # a description generated through xacro for every example robot
 @PREFIXES
 def test_the_robot_files_sensor_keys_place_the_sensors(prefix, tmp_path):
     robot = robot_file_with_sensor_keys(tmp_path)
@@ -346,6 +348,7 @@ def test_every_macro_alone_with_its_defaults(tmp_path):
     ],
     ids=["none", "all", "some"],
 )  # fmt: skip
+@pytest.mark.slow  # a description generated through xacro for every example robot
 def test_gnss_reference_elements_are_written_only_when_given(tmp_path, given, expected):
     extras = extras_file(tmp_path, f'<xacro:gnss_antenna parent="${{tf_prefix}}base_link" name="rtk" {given}/>')
     plugin = model_plugin(tree(STD, "r/", extras), "libhector_gazebo_ros_gps.so")[0]
@@ -393,6 +396,7 @@ def test_check_urdf_accepts_it(prefix, tmp_path):
     assert "Successfully Parsed XML" in result.stdout
 
 
+@pytest.mark.slow  # a description generated through xacro for every example robot
 @pytest.mark.parametrize("robot", EXAMPLE_ROBOTS, ids=robot_id)
 def test_the_example_gives_a_valid_description_for_every_example_robot(robot):
     root = tree(robot, "r/")

@@ -56,6 +56,7 @@ def test_check_urdf_accepts_the_robot(robot, tmp_path):
     assert "root Link: base_link" in result.stdout
 
 
+@pytest.mark.slow  # a description generated through xacro for every example robot
 @robots
 def test_moving_joints_are_those_of_the_configuration(robot):
     expected = expected_moving_joints(robot)
@@ -240,6 +241,7 @@ def test_motor_limits_are_the_motor_torques_through_the_gears():
     assert float(rwd["passive0_wheel"].find("limit").get("effort")) == 0.0
 
 
+@pytest.mark.slow  # a description generated through xacro for every example robot
 @pytest.mark.parametrize("robot", ROBOTS, ids=robot_id)
 def test_the_simulator_block_lists_every_drive_in_order(robot):
     tree = urdf_tree(robot, "r9/")
@@ -273,6 +275,7 @@ def test_suspension_is_a_damped_vertical_joint_within_its_travel(robot):
 
 
 # --- arguments ----------------------------------------------------------------------------------
+@pytest.mark.slow  # a description generated through xacro for every example robot
 def test_model_extras_adds_a_sensor_link():
     tree = urdf_tree(STD, "", EXTRAS)
     assert "lidar_front" in links(tree)

@@ -97,6 +97,7 @@ def test_depth_counts_aliases_expanded(load):
         load(doc(40))
 
 
+@pytest.mark.slow  # 5000 levels of YAML read to the limit
 @pytest.mark.parametrize("load", LOADERS)
 def test_5000_levels_are_refused_without_recursion_error(load):
     with pytest.raises(YamlBoundError):

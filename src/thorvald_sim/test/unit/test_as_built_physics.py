@@ -59,6 +59,7 @@ def straight(sim, robot, speed=0.5, seconds=4.0):
     return x1 - x0, y1 - y0, yaw_of(q1) - yaw_of(q0), [s.speed for s in robot.drive_states(sim.time)]
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_as_configured_is_the_ideal_robot(sim):
     ideal = sim.spawn("a", URDF, Pose2D(), as_built=for_simulator(as_configured(CONFIG), CONFIG))
     plain = sim.spawn("b", URDF, Pose2D(0.0, 4.0))
@@ -147,6 +148,7 @@ def test_reports_come_delay_late(sim):
         assert angle == pytest.approx(lookup[round(t - delay, 6)], abs=1e-3)
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_a_load_weighs(sim):
     light = sim.spawn("light", URDF, Pose2D())
     heavy = sim.spawn("heavy", URDF, Pose2D(0.0, 4.0), as_built=built(mass_offset=50.0))

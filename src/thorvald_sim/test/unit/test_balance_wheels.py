@@ -55,6 +55,7 @@ def balance(as_built: str, offsets_known: bool, legs: int = 6):
     return done, fit_balance(done), [d.r_wheel for d in truth.drives]
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_with_the_offsets_calibrated_the_balance_finds_each_tyres_radius():
     legs, fit, truth = balance("field:3", offsets_known=True)
     assert np.max(np.abs(relative_errors([0.2] * 6, truth))) > 0.01  # configured: 1.2 % off
@@ -63,6 +64,7 @@ def test_with_the_offsets_calibrated_the_balance_finds_each_tyres_radius():
     assert 3000 < fit.stiffness < 10000  # [N m s/m]: the simulator's contacts, about 7000 on every wheel
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_with_the_offsets_off_the_scrub_shifts_the_balance_by_tenths_of_a_percent():
     _, fit, truth = balance("field:3", offsets_known=False)
     error = np.max(np.abs(relative_errors(fit.radii, truth)))
@@ -90,6 +92,7 @@ def leg(session, radii, offsets, speed, length):
     return Leg(tuple(radii), speed, tuple(np.mean(rows, axis=0)))
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_the_toe_searched_from_the_frames_resistance_the_balance_finds_each_tyres_radius_again():
     """The steering offsets as ground truth leaves them (field:3 homed up to 0.43 deg off; the crab and
     the arc of the toe right, as ground truth sees them, the rest at 0): the radii balance alone is

@@ -52,6 +52,7 @@ def open_port(path, bus_class=None):
     return bus
 
 
+@pytest.mark.slow  # pseudo-terminals of a hub, written and read
 def test_participants_see_each_other(hub):
     h, links = hub
     inside = h.participant()

@@ -227,6 +227,7 @@ def test_muting_forgets_the_relayed_frames_a_refused_write_left(robot):
         implement.shutdown()
 
 
+@pytest.mark.slow  # a CAN base and the emulator over thousands of cycles
 def test_a_reader_that_stops_reading_fills_the_virtual_queue_and_loses_no_drive():
     """The emulator stops reading for 1 s: python-can's own virtual bus refuses the base's writes
     (its receiver's queue of 16 frames is full); the base keeps its bus and the newest commands

@@ -41,6 +41,7 @@ def test_a_description_without_motor_constants_gets_the_robot_files_defaults():
         parse_description(broken)
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_a_larger_wheel_brakes_and_the_others_push_and_the_controllers_report_the_currents():
     """Six drives straight ahead at 0.8 m/s on flat ground, base_driver told drive0's wheel is 0.2 %
     larger than it is: it turns drive0's wheel 0.2 % slower than the ground goes by, so the other five
@@ -74,6 +75,7 @@ def test_a_larger_wheel_brakes_and_the_others_push_and_the_controllers_report_th
     assert prop[0][1] == pytest.approx(0.8 * 1.002, rel=0.01) and prop[1][1] == pytest.approx(0.8, rel=0.01)
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_as_built_the_currents_come_as_late_as_the_drive_states():
     client = p.connect(p.DIRECT)
     try:

@@ -44,6 +44,7 @@ def body_mass(client, body):
     return sum(masses), np.average(np.array(in_base_link), axis=0, weights=masses)
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda path: os.path.basename(path)[:-5])
 def test_pybullet_holds_the_descriptions_mass_at_its_centre_of_mass(client, path):
     urdf = generate_urdf(path)
@@ -53,6 +54,7 @@ def test_pybullet_holds_the_descriptions_mass_at_its_centre_of_mass(client, path
     assert com == pytest.approx(np.array(expected.com), abs=1e-6)
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda path: os.path.basename(path)[:-5])
 def test_the_simulator_holds_the_descriptions_mass_at_its_centre_of_mass(client, path):
     """As spawned: fixed links merged, the mass the root link keeps apart (ROOT_MASS) a micrometre's

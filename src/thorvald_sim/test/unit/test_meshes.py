@@ -80,6 +80,7 @@ def test_the_hokuyo_mesh_is_ours_and_reproducible(tmp_path):
     )
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_a_robot_with_users_extras_spawns_without_the_meshes_it_cannot_find():
     client = p.connect(p.DIRECT)
     try:

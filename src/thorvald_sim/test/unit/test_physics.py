@@ -52,6 +52,7 @@ def run(sim, seconds, robot=None, steering=None, speeds=None):
 
 
 # ---- the description ------------------------------------------------------------------------
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: os.path.basename(p)[:-5])
 def test_the_description_lists_the_configurations_drives_in_order(path):
     config = load_robot_config(path)
@@ -95,6 +96,7 @@ def test_a_description_the_simulator_cannot_use_says_why(xml, reason):
 
 
 # ---- robots on the ground -------------------------------------------------------------------
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: os.path.basename(p)[:-5])
 def test_every_example_robot_stands_on_its_wheels_and_drives_straight(sim, path):
     config = load_robot_config(path)
@@ -177,6 +179,7 @@ def test_the_wheels_touch_the_ground_with_thin_discs():
     assert widths(thin, "wheel1_link") == widths(xml, "wheel1_link")
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_wheels_are_torque_limited(sim):
     """A robot with a hundredth of the motor torque cannot reach the commanded speed up front: the
     standard one reaches 0.5 m/s at once, the weak one accelerates at about torque / (r m)."""

@@ -67,6 +67,7 @@ def test_times_pass_through_nanoseconds_as_a_ros_stamp_carries_them():
     assert stamp_time(2.0) == 2.0
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_a_robot_drives_its_commands_and_its_odometry_follows(tmp_path):
     # 4 s ahead at 0.5 m/s from t = 0.5 (the wheels ramp at 1.5 m/s^2: 0.33 s), then 1 s standing
     commands = [TimedTwist(0.5, 0.5, 0.0, 0.0), TimedTwist(4.5, 0.0, 0.0, 0.0)]
@@ -164,6 +165,7 @@ def test_the_help_documents_every_option_and_the_commands_file():
     assert [c.t for c in parsed] == [0.5, 4.5, 8.5] and parsed[1].wz * 4.0 == pytest.approx(math.pi / 2, abs=1e-4)
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_the_fleet_physics_preset_keeps_the_papers_figures_at_half_the_rate():
     """The fleet preset (120 Hz, 50 solver iterations) against the default (240 Hz) on the paper's
     verification manoeuvre, standard robot on tarmac_gravel: the true paths stay within 0.1 m of

@@ -52,6 +52,7 @@ def expected_bodies(world):
     return names
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 @pytest.mark.parametrize("name", shipped_worlds())
 def test_every_shipped_world_builds(client, name):
     world = shipped(name)
@@ -73,6 +74,7 @@ def test_every_shipped_world_builds(client, name):
         assert ray_down(client, 60.0, -70.0) == (scene.bodies["ground"], pytest.approx(0.0, abs=1e-9))
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 @pytest.mark.parametrize("name", shipped_worlds())
 def test_every_shipped_world_leaves_room_for_a_robot_at_the_origin(client, name):
     # a robot of 1.5 x 1.4 m and 1 m tall heading +x, and 5 cm more all round: rays down from 1.2 m every

@@ -36,6 +36,7 @@ def test_the_field_profiles_tyres_give_three_times_their_radius_drop():
     assert not built.ideal
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_on_soft_tyres_every_wheel_carries_load_on_rigid_ones_two_carry_the_robot(tmp_path):
     soft, z_soft = loads("field:3")
     rigid, z_rigid = loads(rigid_copy(tmp_path, "field:3"))

@@ -55,6 +55,7 @@ VALID = {
 }
 
 
+@pytest.mark.slow  # files past the YAML bounds, each read to its limit
 @pytest.mark.parametrize("kind", sorted(LOADERS))
 @pytest.mark.parametrize("past", ["bomb", "deep"])
 def test_every_file_kind_past_the_yaml_bounds_gets_one_clean_line(tmp_path, kind, past):

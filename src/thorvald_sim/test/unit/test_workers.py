@@ -91,6 +91,7 @@ def reads_at(k):
     return Reads(states=k % 3 == 0, currents=k % 24 == 0, odometry=k % 5 == 0, joints=k % 5 == 0)
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_a_robot_in_a_worker_is_the_robot_in_the_nodes_client_to_the_bit(plain, pool):
     built = delayed()
     names = ("std", "built")
@@ -133,6 +134,7 @@ def test_a_robot_in_a_worker_is_the_robot_in_the_nodes_client_to_the_bit(plain, 
         remote["std"].drive_states(plain.time + plain.dt)
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_sensors_read_in_a_worker_read_what_they_read_in_the_nodes_client(plain, pool):
     local = plain.spawn("probe", PROBE, Pose2D(0.0, 0.0))
     remote = pool.spawn("probe", PROBE, Pose2D(0.0, 0.0))
@@ -155,6 +157,7 @@ def test_sensors_read_in_a_worker_read_what_they_read_in_the_nodes_client(plain,
     assert read == 20 + 50  # 40 Hz and 100 Hz over half a simulated second
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_a_workers_sensors_publish_the_messages_the_nodes_own_would(plain, pool):
     """RobotSensors as the node runs it: stepped on its own client, or asking a worker (requests) and
     publishing what it read (publish_readings); every message the same, byte for byte."""
@@ -188,6 +191,7 @@ def serialised(msg) -> bytes:
     return buff.getvalue()
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_spawn_and_delete_refuse_with_the_simulations_words(plain, pool):
     broken = '<robot name="b"><link name="base_link"/><joint name="j" type="fixed"><parent link="base_link"/><child link="nowhere"/></joint></robot>'  # noqa: E501
     cases = [("", URDF), ("twice", URDF), ("twice", URDF), ("broken", broken), ("bad", "<robot")]
@@ -206,6 +210,7 @@ def test_spawn_and_delete_refuse_with_the_simulations_words(plain, pool):
         assert str(e.value) == "no robot named 'ghost'; robots: twice"
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_robots_go_to_their_strips_worker_or_the_least_loaded():
     pool = WorkerPool(3, WorldSettings(FLAT), strips=(0.0, 10.0))
     try:
@@ -225,6 +230,7 @@ def test_robots_go_to_their_strips_worker_or_the_least_loaded():
         WorkerPool(2, WorldSettings(FLAT), strips=(1.0, 2.0))
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_a_killed_worker_is_reported_and_the_others_go_on(pool):
     a = pool.spawn("a", URDF, Pose2D(0.0, 0.0))
     b = pool.spawn("b", URDF, Pose2D(10.0, 0.0))
@@ -252,6 +258,7 @@ def test_a_killed_worker_is_reported_and_the_others_go_on(pool):
     assert pool.solver_cpu > 0.0 and pool.workers_cpu > 0.0
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_a_hung_worker_is_killed_after_the_timeout():
     pool = WorkerPool(2, WorldSettings(FLAT), timeout=1.0)
     try:
@@ -268,6 +275,7 @@ def test_a_hung_worker_is_killed_after_the_timeout():
         pool.close()
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_reset_and_delete_work_across_workers(pool):
     a = pool.spawn("a", URDF, Pose2D(0.0, 0.0, 0.0, 0.5))
     b = pool.spawn("b", URDF, Pose2D(10.0, 0.0))
@@ -287,6 +295,7 @@ def test_reset_and_delete_work_across_workers(pool):
     assert again.worker == 1
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_robots_on_two_workers_closer_than_their_footprints_are_named(pool):
     a = pool.spawn("a", URDF, Pose2D(3.0, 0.0))
     b = pool.spawn("b", URDF, Pose2D(5.0, 0.0))

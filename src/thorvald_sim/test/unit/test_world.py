@@ -99,6 +99,7 @@ def test_tarmac_gravel_has_gravel_on_tarmac_around_the_origin_but_not_at_it():
                 assert not any(pa.contains(x, y) for pa in world.patches), (x, y)
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_tarmac_gravel_patches_do_not_overlap():
     world = shipped("tarmac_gravel")
     for i in range(-220, 221):

@@ -189,6 +189,7 @@ def test_ground_beds_in_pybullet(client):
     assert ray(client, (u, 0.0, 1.5), (u, 0.0, -1.0)) == (plants, pytest.approx((u, 0.0, t.plant_top), abs=1e-4))
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_the_shipped_polytunnel_keeps_an_aisle_along_x_from_the_origin(client):
     world = load_world(resolve_world("polytunnel"))
     scene = build_scene(client, world)

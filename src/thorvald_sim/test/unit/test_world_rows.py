@@ -189,6 +189,7 @@ def test_a_plant_is_as_wide_as_its_radius(client):
         assert hit[0] == body and math.hypot(*hit[3][:2]) == pytest.approx(reach, abs=1e-4), degrees
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_a_row_too_big_for_one_mesh_goes_on_in_parts(client):
     # spheres on stems: 26 + 16 vertices a plant (65536 // 42 = 1560 a body); 2000 of them in two bodies
     world = parse_world({"rows": {"row0": {"x": 0, "y": 0, "length": 199.9, "plant_spacing": 0.1, "plant": "sphere"}}})
@@ -202,6 +203,7 @@ def test_a_row_too_big_for_one_mesh_goes_on_in_parts(client):
     assert ray_down(client, 199.9, 0.0)[0] == scene.bodies["rows.row0.0.part1"]
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_the_shipped_crop_rows_are_where_the_file_says(client):
     world = load_world(resolve_world("crop_rows"))
     scene = build_scene(client, world)

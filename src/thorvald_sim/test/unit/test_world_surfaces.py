@@ -500,6 +500,7 @@ def test_a_rolling_wheel_sinks_as_its_load_says_and_still_rolls_r_omega():
         p.disconnect(client)
 
 
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
 def test_a_robot_standing_on_mud_for_10_s_neither_bounces_nor_drifts():
     client = p.connect(p.DIRECT)
     try:
