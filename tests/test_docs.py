@@ -32,6 +32,7 @@ SYSTEM_EXECUTABLES: Dict[str, Set[str]] = {
     "robot_state_publisher": {"robot_state_publisher"},
     "joint_state_publisher": {"joint_state_publisher"},
     "joint_state_publisher_gui": {"joint_state_publisher_gui"},
+    "tf": {"tf_echo", "tf_monitor", "view_frames"},
 }
 README_MAX_LINES = 300
 WORLD_KEYS_BEGIN = "<!-- world-keys:begin -->"

@@ -36,8 +36,9 @@ the commands file (--commands):
   --hold seconds more; before the first row's t there is no command and the wheels stand.
   At most {MAX_COMMANDS} rows; t within [0, {MAX_DURATION:g}] s. A broken row is named by its line.
 
-  example: 0.5 m/s ahead from 0.5 s (2 m), a quarter turn on the spot from 4.5 s (0.3927 rad/s for
-  4 s), stopped from 8.5 s (for --hold, 1 s):
+  example: 0.5 m/s ahead from 0.5 s (2 m), on the spot at 0.3927 rad/s from 4.5 s (a quarter turn
+  in 4 s, less the wheels' re-steering first: the standard robot ends 83 degrees round), stopped from
+  8.5 s (for --hold, 1 s):
     t,vx,vy,wz
     0.5,0.5,0,0
     4.5,0,0,0.3927
