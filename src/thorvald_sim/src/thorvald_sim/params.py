@@ -4,7 +4,47 @@
 ``rospy.get_param("~" + name, default)``), checks every parameter against its rule and raises
 :class:`~thorvald_sim.errors.ParameterError` naming the parameter, the value and the rule. The node
 reads nothing else from the parameter server; everything after the start works on this value.
-The defaults and what each parameter means: the simulator node's docstring.
+The parameters, their defaults and what each means:
+
+========================  ================================================================
+``~world``                a shipped world's name (``flat``, ``tarmac_gravel``, ``slope``,
+                          ``greenhouse``) or a world file (default ``flat``)
+``~gui``                  open pybullet's window (default false: headless)
+``~physics``              the physics preset (:mod:`thorvald_sim.physics`): ``default`` (240 Hz,
+                          50 solver iterations) or ``fleet`` (120 Hz, 50: about half the CPU
+                          per robot)
+``~physics_rate``         physics steps per simulated second [Hz] (the preset's)
+``~solver_iterations``    pybullet's solver iterations per step (the preset's)
+``~real_time_factor``     simulated seconds per wall second (1); 0 runs as fast as it can
+``~clock_rate``           /clock messages per simulated second [Hz] (80: every third step at 240 Hz
+                          physics; at most one a step)
+``~odometry_rate``        odometry/gazebo and joint_states per simulated second [Hz] (50)
+``~drive_state_rate``     drive_states per simulated second [Hz] (80)
+``~drive_current_rate``   drive_currents per simulated second [Hz] (10: base_driver reports them at
+                          1 Hz; in lockstep they go with every drive_states, for the torque balance)
+``~command_timeout``      a robot whose commands stop for this long [s] stops its wheels (0.5)
+``~max_lag``              the simulator waits for a robot whose commands lag more than this behind
+                          simulated time [s] (0.05; 0: never): a busy machine slows the
+                          simulation instead of letting robots drive on stale commands
+``~publish_tf``           default for robots: tf odom -> base_link from ground truth (true, as
+                          the Gazebo plugin's users had it; spawn_robot's -no_publish_tf or
+                          -publish_tf choose per robot)
+``~tyre_contact_width``   width of the wheels' collision discs [m] (0.01; see robot.py)
+``~paused``               start paused (false)
+``~diagnostics_rate``     /diagnostics per wall second [Hz] (1; 0: none): the real-time factor
+                          reached and the CPU the simulation costs (see ``publish_performance``),
+                          and per robot what each sensor read costs
+``~seed``                 seed of every sensor's noise (0): the same seed repeats a run's noise
+``~datum_file``           a robot_localization datum file: the GNSS reference of robots whose
+                          description has neither a reference nor a datum of its own (none)
+``~lockstep``             advance only when every robot's driver has answered the last instant's
+                          drive states with its command (false; see below)
+``~physics_workers``      pybullet clients stepping the robots, each in a process of its own (1: the
+                          node's own client, as ever; 2..16: see below; 1 with ``~gui``)
+``~worker_strips``        with physics workers: the x [m] between each two workers' strips (N - 1
+                          increasing numbers, a list or a text "9 18"); a robot goes to the worker
+                          of its spawn x's strip (none: to the worker with the fewest robots)
+========================  ================================================================
 
 Pure: no rospy.
 """

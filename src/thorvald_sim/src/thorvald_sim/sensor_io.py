@@ -12,11 +12,12 @@ the robot, the sensor and its topics, and it stays on /diagnostics as an error f
 (:attr:`SensorIO.failure`, :meth:`RobotSensors.disabled`); the simulation, its clock and every
 other sensor and robot go on. Its topics stay advertised, silent, until the robot is deleted.
 
-A robot on a physics worker (:mod:`thorvald_sim.workers`) is measured where its physics is: the node
-asks which sensors have readers (:meth:`RobotSensors.requests`), the worker pauses the others'
-schedules and reads the due ones after its step, and the node makes and publishes the messages of
-what it read (:meth:`RobotSensors.publish_readings`), or disables a sensor whose reading failed there
-with the error's text. Such a sensor sees only its own worker's world (its robots, not the others').
+A robot is measured where its physics is (:mod:`thorvald_sim.engine`: the node's own client or a
+physics worker's): the node asks which sensors have readers (:meth:`RobotSensors.requests`), the
+Engine pauses the others' schedules and reads the due ones after its step by the one schedule
+(:func:`thorvald_sim.sensors.read_due`), and the node makes and publishes the messages of what it
+read (:meth:`RobotSensors.publish_readings`), or disables a sensor whose reading failed with the
+error's text. A sensor on a worker sees only its own worker's world (its robots, not the others').
 """
 
 import importlib
@@ -39,7 +40,7 @@ from .sensor_kinds.camera import CAMERA_DTYPE, packed_rgb
 from .sensor_kinds.camera import CAMERA_FIELDS as CAMERA_FIELD_SPECS
 from .sensor_kinds.lidar import LIDAR_DTYPE
 from .sensor_kinds.lidar import LIDAR_FIELDS as LIDAR_FIELD_SPECS
-from .sensors import DisabledSensor, Sensor, SensorUse
+from .sensors import DisabledSensor, Sensor, SensorUse, read_due
 
 
 def point_fields(specs) -> List[PointField]:
@@ -162,19 +163,24 @@ class SensorIO:
         self.failure: Optional[DisabledSensor] = None  # set when a reading failed: never read again
         self.keep: Dict[str, object] = {}  # the kind's messages and buffers kept from reading to reading
         self.stamp = rospy.Time()  # the instant of the reading being published
+        self._schedule: Dict = {}  # read_due's record of this sensor's readers, when step measures it here
 
     def subscribed(self) -> Dict[str, bool]:
         return {role: pub.get_num_connections() > 0 for role, pub in self.pubs.items()}
 
     def step(self, now: float, wanted: Dict[str, bool]) -> None:
-        """After a physics step at simulated time now: measure and publish if it is due and read. A
-        reading that fails disables this sensor (see the module's docstring); nothing is raised."""
+        """After a physics step at simulated time now, in the process that holds the sensor (a test, a
+        tool): measured by the one schedule (:func:`thorvald_sim.sensors.read_due`) if it is due and
+        read, and published. A reading that fails disables this sensor; nothing is raised."""
         if self.failure is not None:
             return
-        try:
-            self._step(now, wanted)
-        except Exception as e:  # whatever one sensor raises must not stop the simulation
-            self.disable(now, e)
+        self.active = any(wanted.values())
+        results = read_due([self.sensor], [0] if self.active else [], now, self._schedule, self.sensor.robot.name)
+        for result in results.values():
+            if result[0] == "failed":
+                self.failed(now, result[1], result[2])
+            else:
+                self.publish_reading(now, result[1], wanted, result[2])
 
     def disable(self, now: float, error: BaseException) -> None:
         """This sensor is not read again: the error logged once, kept for /diagnostics."""
@@ -195,28 +201,13 @@ class SensorIO:
         )  # fmt: skip
         rospy.logdebug("simulator: %s: sensor %s: %s", robot, spec.name, trace)
 
-    def _step(self, now: float, wanted: Dict[str, bool]) -> None:
-        if not any(wanted.values()):
-            if self.active:
-                self.sensor.schedule.pause()
-                self.active = False
-            return
-        self.active = True
-        if not self.sensor.due(now):
-            return
-        start = time.thread_time()
-        reading = self.sensor.read(now)
-        self._publish(now, reading, wanted)
-        self.cpu += time.thread_time() - start
-        self.readings += 1
-
     def _publish(self, now: float, reading, wanted: Dict[str, bool]) -> None:
         for role, msg in self.messages(reading, rospy.Time.from_sec(now), wanted):
             self.pubs[role].publish(msg)
 
     def publish_reading(self, now: float, reading, wanted: Dict[str, bool], cpu: float) -> None:
-        """A reading at now measured elsewhere (a physics worker: it cost cpu [s] there), published as
-        _step publishes its own; a message that fails disables the sensor, as in step."""
+        """A reading at now measured by the one schedule (in an Engine: it cost cpu [s] there), published;
+        a message that fails disables the sensor."""
         start = time.thread_time()
         try:
             self._publish(now, reading, wanted)
@@ -281,23 +272,27 @@ class RobotSensors:
         self.refused = tuple(refused)  # the sensors the robot spawned without
         self._wanted: List[Dict[str, bool]] = [{} for _ in self.ios]
         self._checked = -math.inf
+        self._schedule: Dict = {}  # read_due's record of the sensors' readers, when step measures them here
 
     def step(self, now: float) -> None:
+        """After a physics step at simulated time now, in the process that holds the sensors (a test, a
+        tool): what the node does across an Engine, here: requests, the one schedule
+        (:func:`thorvald_sim.sensors.read_due`), publish_readings."""
         if not self.ios:
             return
-        self._check(now)
-        for io, wanted in zip(self.ios, self._wanted):
-            io.step(now, wanted)
+        wanted = self.requests(now)
+        sensors = [io.sensor for io in self.ios]
+        self.publish_readings(now, read_due(sensors, wanted, now, self._schedule, sensors[0].robot.name))
 
     def _check(self, now: float) -> None:
         if now - self._checked >= self.CHECK_PERIOD:
             self._checked = now
             self._wanted = [io.subscribed() for io in self.ios]
 
-    # ---- a robot on a physics worker (thorvald_sim.workers): measured there, published here ----------
+    # ---- measured by an Engine (thorvald_sim.engine: the node's or a worker's), published here ------
     def requests(self, now: float) -> Tuple[int, ...]:
-        """Before a worker's step to simulated time now: the indices of the sensors to step with
-        readers (the worker pauses the others' schedules and reads these when due), as step decides."""
+        """Before a step to simulated time now: the indices of the sensors to step with readers (the
+        Engine pauses the others' schedules and reads these when due)."""
         if not self.ios:
             return ()
         self._check(now)
@@ -309,8 +304,8 @@ class RobotSensors:
         return tuple(wanted)
 
     def publish_readings(self, now: float, results: Dict[int, tuple]) -> None:
-        """After the worker's step: each sensor's reading at now published, or its failure (the
-        error's text and trace from the worker) disabling it as a failed reading here would."""
+        """After the step: each sensor's reading at now published, or its failure (the error's text
+        and trace, from wherever it was read) disabling it."""
         for k, result in results.items():
             io = self.ios[k]
             if io.failure is not None:

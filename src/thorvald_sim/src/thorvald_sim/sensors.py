@@ -23,6 +23,8 @@ sensor's period. A run therefore repeats whenever its subscribers came (see Inst
 """
 
 import re
+import time
+import traceback
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple, Union
 
@@ -110,6 +112,36 @@ def build_sensors(
 # What sensors cost (the simulator's /diagnostics)
 # ---------------------------------------------------------------------------------------------
 OK, WARN, ERROR = 0, 1, 2  # diagnostic_msgs/DiagnosticStatus levels
+
+
+def read_due(
+    sensors: Sequence[Sensor], wanted: Sequence[int], now: float, active: Dict[Tuple[str, int], bool], robot: str
+) -> Dict[int, tuple]:
+    """The sensors' one schedule, wherever they are read (the node's client or a physics worker's),
+    after a physics step at simulated time now [s]: a sensor not in wanted (no readers) pauses its
+    schedule the first step it has none; one in wanted is read when due. Returns, by index, ("read",
+    reading, CPU [s]) or ("failed", the error's type and text, its traceback): one sensor's failure
+    must not stop the simulation, and the node disables it alone. active: each (robot, index)'s readers
+    at its last step, kept by the caller."""
+    out = {}
+    for k, sensor in enumerate(sensors):
+        key = (robot, k)
+        if k not in wanted:
+            if active.get(key):
+                sensor.schedule.pause()
+                active[key] = False
+            continue
+        active[key] = True
+        if not sensor.due(now):
+            continue
+        start = time.thread_time()
+        try:
+            reading = sensor.read(now)
+        except Exception as e:  # whatever one sensor raises disables it alone (the node says so)
+            out[k] = ("failed", f"{type(e).__name__}: {e}", traceback.format_exc())
+            continue
+        out[k] = ("read", reading, time.thread_time() - start)
+    return out
 
 
 @dataclass(frozen=True)
@@ -219,6 +251,7 @@ __all__ = [
     "disabled_report",
     "find_mount",
     "ranges_from_hits",
+    "read_due",
     "refused_sensors",
     "sensor_report",
 ]

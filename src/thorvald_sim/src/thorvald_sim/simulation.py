@@ -6,7 +6,7 @@ never connects. Time is the simulated time [s], advanced by one physics step of 
 
 import time
 from dataclasses import dataclass
-from typing import Dict, Optional, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -20,7 +20,7 @@ from .physics import PRESETS
 from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
 from .scene import build_scene
 from .sensor_blocks import Datum
-from .sensors import build_sensors
+from .sensors import build_sensors, disabled_report, sensor_report
 from .world import WorldConfig
 
 SOLVER_ITERATIONS = PRESETS["default"].solver_iterations  # pybullet's default, set explicitly
@@ -255,3 +255,46 @@ def performance_report(
         "CPU share [cores]": f"{perf.cpu / perf.wall:.3f}",
     }
     return level, message, values
+
+
+Status = Tuple[str, str, int, str, Dict[str, str]]  # diagnostic_msgs/DiagnosticStatus: name, hardware id, level, ...
+
+
+def simulator_statuses(
+    node: str,
+    perf: Performance,
+    *,
+    asked: float,
+    paused: bool,
+    physics_rate: float,
+    simulated_now: float,
+    preset: str,
+    solver_iterations: int,
+    workers: int,
+    physics: Sequence[Status] = (),
+    sensors: Sequence[Tuple[str, list]] = (),
+    disabled: Sequence[Tuple[str, object]] = (),
+    robots: int = 0,
+) -> List[Status]:
+    """The simulator node's /diagnostics for a window of wall time: the simulation's
+    (:func:`performance_report`, its physics preset and workers), the physics' own statuses (a worker
+    pool's), each robot's sensors' (sensors: (robot, SensorUse list), :func:`thorvald_sim.sensors.sensor_report`)
+    and one per sensor a robot goes without (disabled: (robot, DisabledSensor)). workers: 0 when the
+    node's own client steps the robots."""
+    level, message, values = performance_report(
+        perf, robots=robots, asked=asked, paused=paused, physics_rate=physics_rate, simulated_now=simulated_now
+    )
+    values["physics preset"] = preset
+    values["solver iterations"] = str(solver_iterations)
+    if workers:
+        values["physics workers"] = str(workers)
+        values["CPU"] = "the node's and its physics workers' processes"
+    out: List[Status] = [(f"{node}: simulation", "pybullet", level, message, values), *physics]
+    out += [
+        (f"{node}: sensors of {name}", name, *sensor_report(uses, perf.simulated, physics_rate, asked))
+        for name, uses in sensors
+    ]
+    out += [
+        (f"{node}: sensor {sensor.name} of {name}", name, *disabled_report(name, sensor)) for name, sensor in disabled
+    ]
+    return out

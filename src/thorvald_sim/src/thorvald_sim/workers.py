@@ -3,9 +3,10 @@
 pybullet's ``stepSimulation`` holds the GIL, so one client in one process steps on one core. With
 ``~physics_workers`` N >= 2 the simulator node starts N worker processes, each a pybullet DIRECT
 client holding the world's static scene (the same :class:`~thorvald_sim.simulation.Simulation`,
-built from the same WorldConfig and physics settings) and its share of the robots. The node keeps
-every robot's ROS side; :class:`WorkerPool` stands in for the Simulation it would otherwise step,
-and :class:`RobotProxy` for each robot.
+built from the same WorldConfig and physics settings, in an :class:`~thorvald_sim.engine.Engine`)
+and its share of the robots. The node keeps every robot's ROS side; :class:`WorkerPool` offers the
+physics interface of :mod:`thorvald_sim.engine` as :class:`~thorvald_sim.engine.LocalPhysics` does
+in the node's own process, and a :class:`~thorvald_sim.engine.RobotProxy` stands for each robot.
 
 * **Processes:** each worker is a fresh interpreter (``python -c "from thorvald_sim.workers import
   serve; serve(FD)"``) talking over a socket pair with multiprocessing's Connection (pickled
@@ -22,10 +23,11 @@ and :class:`RobotProxy` for each robot.
   readings kept when they are read) are the same to the bit: pybullet steps a robot the same whatever
   other bodies its client holds (the unit tests compare a robot in a pool and in a Simulation).
 * **Sensors:** the due check and ``Sensor.read`` run in the worker (its schedule, noise and state
-  are there); the reading (numpy arrays) or the failure's text comes back, and the node makes the
-  messages and publishes them (:meth:`thorvald_sim.sensor_io.RobotSensors.publish_readings`). A lidar
-  or a camera sees only its own worker's world: the static scene and the robots on that worker,
-  not the robots on the others.
+  are there: :func:`thorvald_sim.sensors.read_due`, the one schedule); the reading (numpy arrays)
+  or the failure's text comes back, and the node makes the messages and publishes them
+  (:meth:`thorvald_sim.sensor_io.RobotSensors.publish_readings`). A lidar or a camera sees only
+  its own worker's world: the static scene and the robots on that worker, not the robots on the
+  others.
 * **Placement:** by strips along x of the spawn pose (``strips``: N - 1 increasing x [m]; worker k
   takes x in [strips[k-1], strips[k])); without strips, or when the strip's worker died, the worker
   with the fewest robots. A robot stays on its worker: robots on different workers cannot touch each
@@ -38,7 +40,7 @@ and :class:`RobotProxy` for each robot.
   pid and its robots; its robots are marked dead (``RobotProxy.alive``), the other workers go on,
   and :meth:`WorkerPool.delete` still removes them.
 
-No ROS here: the node converts messages. pybullet is imported by the worker's side (Simulation).
+No ROS here: the node converts messages. pybullet is imported by the worker's side (the Engine).
 """
 
 import bisect
@@ -49,14 +51,14 @@ import subprocess
 import sys
 import time
 import traceback
-from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
+from .engine import NOTHING, Engine, Reads, RobotProxy, WorldSettings, queued_and_asked, took
 from .errors import SpawnError
 from .params import MAX_WORKERS
-from .robot import TYRE_CONTACT_WIDTH, Pose2D
-from .simulation import SOLVER_ITERATIONS, Camera, Simulation
+from .robot import Pose2D
+from .simulation import Camera
 
 REPLY_TIMEOUT = 5.0  # [s] wall: a worker that has not answered a step in this long is killed
 START_TIMEOUT = 60.0  # [s] wall: a worker's interpreter, pybullet and the world's scene, on a busy machine
@@ -66,33 +68,6 @@ PROXIMITY_MARGIN = 0.5  # [m] beyond two robots' footprint radii: closer than th
 
 class WorkerError(RuntimeError):
     """A worker that could not start, or failed a request other than a spawn's refusal (its text)."""
-
-
-@dataclass(frozen=True)
-class WorldSettings:
-    """What a worker builds its Simulation from: the node's world and physics parameters."""
-
-    world: Any  # thorvald_sim.world.WorldConfig
-    physics_rate: float = 240.0
-    tyre_contact_width: float = TYRE_CONTACT_WIDTH
-    seed: int = 0
-    datum: Any = None  # thorvald_sim.sensor_blocks.Datum
-    solver_iterations: int = SOLVER_ITERATIONS
-
-
-class Reads(NamedTuple):
-    """What of one robot is read after a step: drive states, drive currents, odometry (pose and
-    twist), the passive joints' states, and the indices of its sensors that have readers."""
-
-    states: bool = False
-    currents: bool = False
-    odometry: bool = False
-    joints: bool = False
-    sensors: Tuple[int, ...] = ()
-
-
-EVERYTHING = Reads(True, True, True, True)
-NOTHING = Reads()
 
 
 class WorkerDeath(NamedTuple):
@@ -120,86 +95,6 @@ class TooClose(NamedTuple):
 # ---------------------------------------------------------------------------------------------
 # The node's side
 # ---------------------------------------------------------------------------------------------
-class SensorProxy:
-    """One sensor of a robot on a worker: its spec (the SensorSpec the worker's model was made from)
-    and its robot, what the node's SensorIO reads of a sensor; it is measured in the worker."""
-
-    def __init__(self, spec, robot: "RobotProxy", index: int):
-        self.spec = spec
-        self.robot = robot
-        self.index = index  # in its robot's sensors: how a worker's reading names it
-
-
-class RobotProxy:
-    """A robot on a worker, as the node's RobotIO, say_sensors and diagnostics read it: the metadata
-    the worker's SimRobot had at its spawn, commands queued for the next step, and measurements
-    answered from what the worker read for the instant after the last step (a measurement that was
-    not read for that instant is a programming error: RuntimeError)."""
-
-    def __init__(self, name: str, worker: int, pose: Pose2D, info: Dict[str, Any]):
-        self.name = name
-        self.worker = worker
-        self.spawn_pose = pose
-        self.description = info["description"]
-        self.wheels = info["wheels"]
-        self.passive = info["passive"]
-        self.springs = info["springs"]
-        self.sensor_blocks = info["sensor_blocks"]
-        self.sensor_problems = info["sensor_problems"]
-        self.missing_meshes = info["missing_meshes"]
-        self.radius = info["radius"]  # [m] footprint: base_link to the farthest corner of its links' boxes, xy
-        self.sensors = [SensorProxy(spec, self, k) for k, spec in enumerate(info["sensors"])]
-        self.alive = True  # False once its worker died
-        self.queued: Optional[tuple] = None  # ("apply", command) or ("hold",) for the next step
-        self.instant: Optional[float] = None  # [s] simulated: what follows was read then (drives: as stamped)
-        self.got = NOTHING
-        self.position: Optional[Tuple[float, float]] = None  # base_link in the world's xy at the last positions read
-        self._reading: tuple = (None, None, None, None, None)  # states, currents, odometry, joints, sensors
-
-    # ---- commands, queued for the next step -----------------------------------------------------
-    def command(self, steering, speeds, max_steering_speeds=None) -> None:
-        n = len(self.wheels)
-        if len(steering) != n or len(speeds) != n:
-            raise ValueError(f"{self.name}: {n} drives, got {len(steering)} steering and {len(speeds)} speed values")
-        limits = list(max_steering_speeds) if max_steering_speeds else None
-        self.queued = ("apply", (list(steering), list(speeds), limits))
-
-    def hold(self) -> None:
-        self.queued = ("hold",)
-
-    # ---- measurements of the last step's instant ---------------------------------------------
-    def _read(self, what: str, index: int, now: Optional[float]):
-        if not getattr(self.got, what) or (now is not None and now != self.instant):
-            raise RuntimeError(f"{self.name}: {what} not read at {now} (read at {self.instant}: {self.got})")
-        return self._reading[index]
-
-    def drive_states(self, now: Optional[float] = None):
-        return self._read("states", 0, now)
-
-    def drive_currents(self, now: Optional[float] = None):
-        return self._read("currents", 1, now)
-
-    def odom_pose(self):
-        return self._read("odometry", 2, None)[0]
-
-    def body_twist(self):
-        return self._read("odometry", 2, None)[1]
-
-    def joint_states(self, joints: Sequence[int]):
-        return self._read("joints", 3, None)
-
-    @property
-    def sensor_results(self) -> Dict[int, tuple]:
-        """The sensors measured at the last step's instant, by index: ("read", reading, CPU [s]) or
-        ("failed", the error's type and text, its traceback)."""
-        return self._reading[4] or {}
-
-    def _took(self, instant: float, reads: Reads, reading: Optional[tuple]) -> None:
-        self.instant = instant
-        self.got = reads if reading is not None else NOTHING
-        self._reading = reading if reading is not None else (None, None, None, None, None)
-
-
 class _Worker:
     """One worker process and the node's end of its socket."""
 
@@ -269,6 +164,7 @@ class WorkerPool:
         self.steps = 0
         self.robots: Dict[str, RobotProxy] = {}
         self.deaths: List[WorkerDeath] = []  # every worker that died, in order
+        self.died_at: List[Tuple[WorkerDeath, float]] = []  # and the simulated time [s] it died at
         self._unreported: List[WorkerDeath] = []  # died since the last step's report
         self.workers: List[_Worker] = []
         try:
@@ -294,9 +190,45 @@ class WorkerPool:
         return sum(w.solver_cpu for w in self.workers)
 
     @property
-    def workers_cpu(self) -> float:
+    def cpu_elsewhere(self) -> float:
         """[s] of CPU the worker processes spent, every thread (each worker's last report)."""
         return sum(w.cpu for w in self.workers)
+
+    def placed(self, robot: RobotProxy) -> str:
+        """Where a spawned robot's physics runs, for the spawn's answer."""
+        return f", on physics worker {robot.worker}"
+
+    def statuses(self, node: str, alive: Dict[str, bool]) -> List[Tuple[str, str, int, str, Dict[str, str]]]:
+        """The workers' /diagnostics, as (name, hardware id, level, message, values): one status with
+        each worker's pid, robots and CPU (a warning while robots on different workers are too close,
+        an error with a dead worker), and an error per robot whose worker died (alive: the robots the
+        node still holds, by name, and whether their topics live)."""
+        too_close = self.too_close()
+        values = {"workers": str(len(self.workers))}
+        for w in self.workers:
+            state = "alive" if w.alive else "dead"
+            values[f"worker {w.index}"] = f"pid {w.pid}, {state}, robots: {', '.join(w.robots) or 'none'}"
+            values[f"worker {w.index} CPU [s]"] = f"{w.cpu:.3f}"
+        for pair in too_close:
+            values[f"{pair.a} and {pair.b}"] = f"{pair.distance:.2f} m apart, closer than {pair.limit:.2f} m"
+        level, message = 0, f"{len(self.workers)} physics workers"
+        if too_close:
+            level = 1
+            message += "; robots on different workers too close to touch: " + ", ".join(
+                f"{pair.a} and {pair.b}" for pair in too_close
+            )
+        dead = [w for w in self.workers if not w.alive]
+        if dead:
+            level = 2
+            message += "; dead: " + ", ".join(f"worker {w.index} (pid {w.pid})" for w in dead)
+        out = [(f"{node}: physics workers", "pybullet", level, message, values)]
+        for death, since in self.died_at:
+            for name in death.robots:
+                if alive.get(name) is False:  # not deleted since (nor spawned again, on another worker)
+                    why = f"{name}: {death} at {since:.3f} s; its topics are silent"
+                    robot = {"robot": name, "worker": str(death.worker), "pid": str(death.pid), "why": death.reason}
+                    out.append((f"{node}: robot {name}", name, 2, why, robot))
+        return out
 
     def worker_of(self, name: str) -> int:
         return self.robots[name].worker
@@ -306,6 +238,7 @@ class WorkerPool:
         w.alive = False
         w.kill()
         death = WorkerDeath(w.index, w.pid, tuple(w.robots), reason)
+        self.died_at.append((death, self.time))
         for name in w.robots:
             robot = self.robots[name]
             robot.alive = False
@@ -391,13 +324,14 @@ class WorkerPool:
         for w in sent:
             self._receive(w, REQUEST_TIMEOUT)
 
-    def render(self, camera: Optional[Camera] = None):
-        """(image, worker) of the first live worker's world (its scene and its robots only)."""
+    def render(self, camera: Optional[Camera] = None) -> Tuple[Any, str]:
+        """(image, whose world it is) of the first live worker's world: its scene and its robots only."""
         for w in self.workers:
             if w.alive:
                 reply = self._call(w, ("render", camera or Camera()))
                 if reply is not None:
-                    return reply[1], w.index
+                    robots = ", ".join(w.robots) or "none"
+                    return reply[1], f", the world of physics worker {w.index} only (its robots: {robots})"
         raise WorkerError("every physics worker died: nothing to render")
 
     def step(
@@ -415,14 +349,7 @@ class WorkerPool:
         for w in self.workers:
             if not w.alive:
                 continue
-            commands, asked = {}, {}
-            for name in w.robots:
-                robot = self.robots[name]
-                if robot.queued is not None:
-                    commands[name], robot.queued = robot.queued, None
-                r = EVERYTHING if reads is None else reads.get(name, NOTHING)
-                if r != NOTHING:
-                    asked[name] = r
+            commands, asked = queued_and_asked([self.robots[name] for name in w.robots], reads)
             if self._send(w, ("step", commands, asked, positions, stamped)):
                 sent.append((w, asked))
         pending = {w.conn: (w, asked) for w, asked in sent}
@@ -451,11 +378,7 @@ class WorkerPool:
 
     def _took(self, w: _Worker, instant: float, asked: Dict[str, Reads], reply) -> None:
         _, w.solver_cpu, w.cpu, readings, places = reply
-        for name in w.robots:
-            robot = self.robots[name]
-            robot._took(instant, asked.get(name, NOTHING), readings.get(name))
-            if places is not None:
-                robot.position = places.get(name)
+        took([self.robots[name] for name in w.robots], instant, asked, readings, places)
 
     def too_close(self, margin: float = PROXIMITY_MARGIN) -> List[TooClose]:
         """The pairs of live robots on different workers whose last positions are closer than their
@@ -497,129 +420,6 @@ def physics_rate_ok(rate) -> bool:
 # ---------------------------------------------------------------------------------------------
 # The worker's side
 # ---------------------------------------------------------------------------------------------
-def footprint_radius(robot) -> float:
-    """[m] from base_link to the farthest corner of its links' bounding boxes in the world's xy, at spawn."""
-    from .bullet import pybullet as p  # noqa: PLC0415  (the worker's side: the node never calls it)
-
-    (x, y, _), _ = robot.world_pose()
-    radius = 0.0
-    for link in range(-1, p.getNumJoints(robot.body, physicsClientId=robot.client)):
-        low, high = p.getAABB(robot.body, link, physicsClientId=robot.client)
-        for cx in (low[0], high[0]):
-            for cy in (low[1], high[1]):
-                radius = max(radius, math.hypot(cx - x, cy - y))
-    return radius
-
-
-class Engine:
-    """A worker's world: a DIRECT client, its Simulation, and the requests of the node
-    (:meth:`handle`). Usable in one process too (the tests compare it with a plain Simulation)."""
-
-    def __init__(self, settings: WorldSettings):
-        from .bullet import pybullet as p  # noqa: PLC0415  (the worker's side: the node never calls it)
-
-        self.client = p.connect(p.DIRECT)
-        s = settings
-        self.sim = Simulation(
-            self.client, s.world, s.physics_rate, s.tyre_contact_width, seed=s.seed, datum=s.datum,
-            solver_iterations=s.solver_iterations,
-        )  # fmt: skip
-        self.active: Dict[Tuple[str, int], bool] = {}  # a sensor had readers at its last step
-        self.passive: Dict[str, List[int]] = {}  # each robot's joints RobotIO reports, listed once at its spawn
-
-    def handle(self, request):
-        kind = request[0]
-        if kind == "step":
-            return self.step(*request[1:])
-        if kind == "spawn":
-            return self.spawn(*request[1:])
-        if kind == "delete":
-            try:
-                self.sim.delete(request[1])
-            except SpawnError as e:
-                return ("refused", str(e))
-            self.passive.pop(request[1], None)
-            return ("deleted",)
-        if kind == "reset":
-            self.sim.reset()
-            return ("reset",)
-        if kind == "render":
-            return ("image", self.sim.render(request[1]))
-        raise ValueError(f"unknown request {kind!r}")
-
-    def spawn(self, name, urdf, pose, as_built):
-        try:
-            robot = self.sim.spawn(name, urdf, pose, as_built)
-        except SpawnError as e:
-            return ("refused", str(e))
-        self.passive[name] = [j for j, _ in robot.passive] + [j for j, _ in robot.springs]
-        info = {
-            "description": robot.description,
-            "wheels": robot.wheels,
-            "passive": robot.passive,
-            "springs": robot.springs,
-            "sensors": [s.spec for s in robot.sensors],
-            "sensor_blocks": robot.sensor_blocks,
-            "sensor_problems": robot.sensor_problems,
-            "missing_meshes": robot.missing_meshes,
-            "radius": footprint_radius(robot),
-        }
-        return ("spawned", info)
-
-    def step(self, commands, reads, positions, stamped=None):
-        sim = self.sim
-        for name, command in commands.items():
-            robot = sim.robots[name]
-            if command[0] == "apply":
-                robot.command(*command[1])
-            else:
-                robot.hold()
-        sim.step()
-        now = sim.time
-        drives_now = now if stamped is None else stamped
-        readings = {}
-        for name, robot in sim.robots.items():
-            r = reads.get(name, NOTHING)
-            # in the node's order: currents, then drive states, then odometry and passive joints, then sensors
-            currents = robot.drive_currents(drives_now) if r.currents else None
-            states = robot.drive_states(drives_now) if r.states else None
-            odometry = (robot.odom_pose(), robot.body_twist()) if r.odometry else None
-            joints = None
-            if r.joints:  # RobotIO's passive joints (pybullet reads no joints as None)
-                passive = self.passive[name]
-                joints = robot.joint_states(passive) if passive else []
-            sensors = self.read_sensors(robot, now, r.sensors)
-            if r != NOTHING or sensors:
-                readings[name] = (states, currents, odometry, joints, sensors)
-        places = None
-        if positions:
-            places = {name: robot.world_pose()[0][:2] for name, robot in sim.robots.items()}
-        return ("stepped", sim.solver_cpu, time.process_time(), readings, places)
-
-    def read_sensors(self, robot, now: float, wanted: Sequence[int]) -> Dict[int, tuple]:
-        """Each sensor of the robot as the node's SensorIO steps it: a sensor without readers pauses
-        its schedule; one with readers is read when due (its failure's text instead of raising)."""
-        out = {}
-        for k, sensor in enumerate(robot.sensors):
-            key = (robot.name, k)
-            if k not in wanted:
-                if self.active.get(key):
-                    sensor.schedule.pause()
-                    self.active[key] = False
-                continue
-            self.active[key] = True
-            if not sensor.due(now):
-                continue
-            start = time.thread_time()
-            try:
-                reading = sensor.read(now)
-            except Exception as e:  # whatever one sensor raises disables it alone (the node says so)
-                out[k] = ("failed", f"{type(e).__name__}: {e}", traceback.format_exc())
-                continue
-            out[k] = ("read", reading, time.thread_time() - start)
-        return out
-
-
 def serve(fd: int) -> None:
     """A worker process's life: its world from the first message, then one reply per request until
     the node closes its end (or says "close")."""
@@ -656,20 +456,13 @@ def serve(fd: int) -> None:
 
 
 __all__ = [
-    "EVERYTHING",
     "MAX_WORKERS",
-    "NOTHING",
     "PROXIMITY_MARGIN",
     "REPLY_TIMEOUT",
     "REQUEST_TIMEOUT",
-    "Engine",
-    "Reads",
-    "RobotProxy",
-    "SensorProxy",
     "TooClose",
     "WorkerDeath",
     "WorkerError",
     "WorkerPool",
-    "WorldSettings",
     "serve",
 ]

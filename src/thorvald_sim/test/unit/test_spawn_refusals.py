@@ -190,17 +190,17 @@ def test_spawn_robot_parses_names_with_the_rules(capsys):
 
 def test_the_simulators_spawn_service_refuses_the_names_before_anything():
     from thorvald_msgs.srv import SpawnRobotRequest  # noqa: PLC0415
-    from thorvald_sim.simulator_node import SimulatorNode  # noqa: PLC0415
+    from thorvald_sim.services import SimulatorServices  # noqa: PLC0415
 
     class Untouchable:
-        """A simulator node that fails the test if the service goes past its checks."""
+        """Simulator services that fail the test if the spawn goes past its checks."""
 
         def __getattr__(self, name):
             raise AssertionError(f"srv_spawn used self.{name} for a request it must refuse")
 
     def spawn(model, namespace):
         request = SpawnRobotRequest(model_name=model, robot_namespace=namespace, robot_description="<robot/>")
-        return SimulatorNode.srv_spawn(Untouchable(), request)
+        return SimulatorServices.srv_spawn(Untouchable(), request)
 
     response = spawn("robot_1", "/bad ns")
     assert not response.success and response.message.startswith("robot namespace '/bad ns': must be a legal ROS")

@@ -16,10 +16,11 @@ from sim_test_helpers import Recorder
 
 from thorvald_model.description import generate_urdf
 from thorvald_sim.as_built import AsBuilt, DriveAsBuilt, for_simulator
+from thorvald_sim.engine import NOTHING, LocalPhysics, Reads, WorldSettings
 from thorvald_sim.robot import Pose2D
 from thorvald_sim.sensor_io import RobotSensors
 from thorvald_sim.simulation import Simulation, SpawnError
-from thorvald_sim.workers import NOTHING, PROXIMITY_MARGIN, Reads, WorkerPool, WorldSettings
+from thorvald_sim.workers import PROXIMITY_MARGIN, WorkerPool
 from thorvald_sim.world import parse_world
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -132,6 +133,37 @@ def test_a_robot_in_a_worker_is_the_robot_in_the_nodes_client_to_the_bit(plain, 
     assert local["std"].odom_pose()[0][0] > 0.3  # it drove
     with pytest.raises(RuntimeError, match="states not read"):
         remote["std"].drive_states(plain.time + plain.dt)
+
+
+@pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
+def test_the_nodes_own_physics_reads_what_a_plain_simulation_does_to_the_bit(plain):
+    """LocalPhysics, the node's own client behind the physics interface the workers offer: the same
+    robot, commands and reads give the same readings to the bit as a Simulation read directly."""
+    local = LocalPhysics(WorldSettings(FLAT, seed=3))
+    try:
+        a = plain.spawn("built", URDF, Pose2D(8.0, 3.0), delayed())
+        b = local.spawn("built", URDF, Pose2D(8.0, 3.0), delayed())
+        for k in range(1, 361):
+            command = commands(k)
+            for robot in (a, b):
+                if command == "hold":
+                    robot.hold()
+                elif command is not None:
+                    robot.command(*command)
+            reads = reads_at(k)
+            plain.step()
+            now = genpy.Time.from_sec(plain.time).to_sec()
+            assert local.step({"built": reads}, stamped=now) == [] and local.time == plain.time
+            if reads.states:
+                assert b.drive_states(now) == a.drive_states(now), k
+            if reads.currents:
+                assert b.drive_currents(now) == a.drive_currents(now), k
+            if reads.odometry:
+                assert (b.odom_pose(), b.body_twist()) == (a.odom_pose(), a.body_twist()), k
+        assert a.odom_pose()[0][0] > 0.3  # it drove (in its odom frame, from its spawn pose)
+        assert local.too_close() == [] and local.placed(b) == "" and local.statuses("/simulator", {}) == []
+    finally:
+        local.close()
 
 
 @pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
@@ -255,7 +287,7 @@ def test_a_killed_worker_is_reported_and_the_others_go_on(pool):
     pool.delete("b")  # a dead worker's robots are still removed
     assert sorted(pool.robots) == ["a", "c"]
     assert pool.spawn("d", URDF, Pose2D(20.0, 0.0)).worker == 0  # its strip's worker is dead: the live one
-    assert pool.solver_cpu > 0.0 and pool.workers_cpu > 0.0
+    assert pool.solver_cpu > 0.0 and pool.cpu_elsewhere > 0.0
 
 
 @pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it
