@@ -12,7 +12,7 @@ from typing import Dict, Tuple
 from thorvald_model import load_robot_config
 from thorvald_model.description import generate_urdf
 from thorvald_model.mass_properties import mass_properties
-from thorvald_sim.world.values import SURFACE_KINDS
+from thorvald_sim.world.surfaces import SURFACE_KINDS
 
 from .quasi_static import Layout, gradeability, layout_of, max_pull, overturning_angles
 

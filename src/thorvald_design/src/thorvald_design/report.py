@@ -47,7 +47,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
 from thorvald_model.errors import ThorvaldModelError
-from thorvald_sim.world import element_kinds, parse_world, plant_positions
+from thorvald_sim.world import element_kinds, parse_world
+from thorvald_sim.world.kinds.rows import plant_positions
 
 from .metrics import convex_hull
 from .optimise import pareto_front

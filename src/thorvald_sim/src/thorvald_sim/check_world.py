@@ -13,7 +13,8 @@ from typing import List, Optional, Tuple
 
 from thorvald_model.check_report import report
 
-from .world import ConfigError, WorldConfig, element_kinds, load_world, plant_positions, resolve_world
+from .world import ConfigError, WorldConfig, element_kinds, load_world, resolve_world
+from .world.kinds.rows import plant_positions
 
 Box = Tuple[float, float, float, float]  # (x min, y min, x max, y max) [m]
 
@@ -31,7 +32,7 @@ def plant_count(world: WorldConfig) -> int:
 
 def extent(world: WorldConfig) -> Optional[Box]:
     """The box [m] around everything on the ground (None for the ground alone): each element's
-    footprint, as its kind gives it (:mod:`thorvald_sim.world.footprints`)."""
+    footprint, as its kind gives it (:attr:`thorvald_sim.world.kind.ElementKind.footprint`)."""
     points: List[Tuple[float, float]] = []
     for kind in element_kinds():
         if kind.footprint is not None:

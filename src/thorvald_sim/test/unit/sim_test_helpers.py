@@ -9,7 +9,7 @@ import io
 import pybullet as p
 import pytest
 
-from thorvald_sim.world import ConfigError, parse_world
+from thorvald_sim.world import LIMITS, ConfigError, parse_world
 
 
 @pytest.fixture
@@ -27,10 +27,10 @@ def ray_down(client, x, y, top=5.0, bottom=-1.0):
     return body, top - fraction * (top - bottom)
 
 
-def world_problems(data, source="test-world", base_dir=None):
-    """The problems parse_world finds in data, by key path (it must find some)."""
+def world_problems(data, source="test-world", base_dir=None, limits=LIMITS):
+    """The problems parse_world finds in data held to the limits, by key path (it must find some)."""
     with pytest.raises(ConfigError) as e:
-        parse_world(data, source, base_dir)
+        parse_world(data, source, base_dir, limits)
     return {pr.path: pr for pr in e.value.problems}
 
 

@@ -7,17 +7,10 @@ import pytest
 import yaml
 
 import thorvald_sim.world as world_module
-from thorvald_sim.world import (
-    ConfigError,
-    Patch,
-    Surface,
-    load_world,
-    parse_world,
-    plant_positions,
-    resolve_world,
-    shipped_worlds,
-    worlds_dir,
-)
+from thorvald_sim.world import ConfigError, load_world, parse_world, resolve_world, shipped_worlds, worlds_dir
+from thorvald_sim.world.kinds.patches import Patch
+from thorvald_sim.world.kinds.rows import plant_positions
+from thorvald_sim.world.surfaces import Surface
 
 SHIPPED = ["crop_rows", "farm_track", "flat", "greenhouse", "polytunnel", "slope", "tarmac_gravel", "vineyard"]
 

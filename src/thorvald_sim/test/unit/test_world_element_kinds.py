@@ -1,93 +1,46 @@
 """A new kind of world element is one module and one registry line.
 
-The first part of this file is such a module: fence posts (``posts:``, entries ``post0``, ...), a
-cylinder standing on the ground at ``x``, ``y``, of a ``radius`` and ``height``: its value type, its
-keys, its maker (with a rule between two keys), its budget and its scene builder. The registry line
-is ``registered(POSTS)``: the tests load world files with posts, read their values and problems,
-hold them to the budgets, build them in pybullet, and check_world counts them and their extent.
+The module is :mod:`sim_posts_kind`, outside the simulator's package: fence posts (``posts:``,
+entries ``post0``, ...), its value type, keys, maker (with a rule between two keys), budget,
+footprint and scene builder. The registry line is ``registered(POSTS)``: the tests load world files
+with posts, read their values and problems, hold them to the budgets, build them in pybullet, and
+check_world counts them and their extent. The built-in kinds are made the same way: each is whole in
+its own module of :mod:`thorvald_sim.world.kinds`, which nothing else of the world's loading or the
+scene imports, and one line of the registry.
 """
 
+import importlib
+import inspect
 import math
-from dataclasses import dataclass, replace
+import os
+import pkgutil
+from dataclasses import replace
 
-import pybullet as p
+import numpy as np
 import pytest
 import yaml
+from PIL import Image
+from sim_posts_kind import POST_KEYS, POSTS, Post
 from sim_test_helpers import ray_down
 
-from thorvald_model.errors import Problem
+import thorvald_sim.world
 from thorvald_model.schema import Key
-from thorvald_sim import world as world_module
 from thorvald_sim.check_world import format_elements, summary
-from thorvald_sim.scene import build_scene, builder_of
+from thorvald_sim.scene import build_scene
 from thorvald_sim.world import (
     BUILT_IN,
-    COORDINATE,
-    LENGTH,
+    LIMITS,
     ConfigError,
-    Context,
-    ElementKind,
-    Entry,
-    bodies_each,
-    budgets,
+    Limits,
     element_kinds,
-    elements,
-    keys_markdown,
+    kinds,
     load_world,
     parse_world,
     registered,
     top_level_keys,
 )
-
-
-# ---------------------------------------------------------------------------------------------
-# The kind's module
-# ---------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Post:
-    """A fence post: a cylinder standing on the ground."""
-
-    name: str
-    index: int
-    x: float  # [m] of its axis
-    y: float  # [m]
-    z: float  # [m] of its foot: the ground under its axis
-    radius: float  # [m]
-    height: float  # [m]
-
-
-POST_KEYS = (
-    Key("x", float, **COORDINATE),
-    Key("y", float, **COORDINATE),
-    Key("radius", float, 0.05, **LENGTH),
-    Key("height", float, **LENGTH),
-)
-
-
-def make_post(entry: Entry, context: Context) -> Post:
-    v = entry.values
-    broken = {pr.path for pr in context.problems}
-    if v["height"] < 2 * v["radius"] and f"{entry.path}.radius" not in broken:
-        rule = f"must be >= 2 * radius ({2 * v['radius']} m): a post, not a disc"
-        context.problems.append(Problem(f"{entry.path}.height", v["height"], rule))
-    z = context.ground_at(v["x"], v["y"])
-    return Post(entry.name, entry.index, v["x"], v["y"], z, v["radius"], v["height"])
-
-
-def build_post(client: int, world, post: Post, name: str, bodies: dict) -> None:
-    shape = p.createCollisionShape(p.GEOM_CYLINDER, radius=post.radius, height=post.height, physicsClientId=client)
-    centre = (post.x, post.y, post.z + post.height / 2)
-    bodies[name] = p.createMultiBody(0, shape, -1, basePosition=centre, physicsClientId=client)
-
-
-def post_footprint(post: Post):
-    return [(post.x - post.radius, post.y - post.radius), (post.x + post.radius, post.y + post.radius)]
-
-
-POSTS = ElementKind(
-    "posts", "post", POST_KEYS, make_post, build_post, budget=bodies_each(looks=True), doc="fence posts",
-    footprint=post_footprint,
-)  # fmt: skip
+from thorvald_sim.world.keys_table import keys_markdown
+from thorvald_testing.sources import imported_names
 
 # ---------------------------------------------------------------------------------------------
 # The tests
@@ -122,7 +75,9 @@ def test_a_world_file_with_posts_loads_their_values(tmp_path):
         Post("post2", 2, 12.0, -1.0, pytest.approx(0.5), 0.05, 0.5),
     )
     assert world.elements("posts") == world.posts
-    assert world.extra == (("posts", world.posts),)
+    # the registry's order: the built-in kinds', then the posts
+    assert world.sections[-1] == ("posts", world.posts)
+    assert [section for section, _ in world.sections] == [*(kind.section for kind in BUILT_IN), "posts"]
     # the rest of the world as without posts
     without = parse_world({key: value for key, value in WORLD.items() if key != "posts"})
     assert (world.slopes, world.walls) == (without.slopes, without.walls)
@@ -156,24 +111,20 @@ def test_a_broken_posts_entry_names_each_problem(tmp_path):
     assert f"{path}: posts.post1.radius: -0.1: must be in (0, 10000] [m]" in str(e.value).splitlines()[2]
 
 
-def test_posts_take_their_share_of_the_budgets(monkeypatch):
+def test_posts_take_their_share_of_the_budgets():
     # three posts, a hill and a wall, and the ground: 6 bodies
-    monkeypatch.setattr(world_module, "MAX_BODIES", 5)
     with registered(POSTS), pytest.raises(ConfigError) as e:
-        parse_world(WORLD)
+        parse_world(WORLD, limits=Limits(bodies=5))
     rule = "makes 6 pybullet bodies over the world's entries and the ground, 3 of them here; at most 5"
     assert [(pr.path, pr.value, pr.rule) for pr in e.value.problems] == [("posts", 3, rule)]
-    monkeypatch.setattr(world_module, "MAX_BODIES", 6)
     # each of the 3 posts looks for the ground once, over the plane and the hill: 6 look-ups; the
     # wall's 4 m every 0.5 m: 9 points, 18 look-ups; 24 in all
-    monkeypatch.setattr(world_module, "MAX_GROUND_LOOKUPS", 23)
     with registered(POSTS), pytest.raises(ConfigError) as e:
-        parse_world(WORLD)
+        parse_world(WORLD, limits=Limits(bodies=6, ground_lookups=23))
     assert [pr.path for pr in e.value.problems] == ["walls.wall0.length"]
     assert e.value.problems[0].rule.startswith("makes 24 ground look-ups")
-    monkeypatch.setattr(world_module, "MAX_GROUND_LOOKUPS", 24)
     with registered(POSTS):
-        assert len(parse_world(WORLD).posts) == 3
+        assert len(parse_world(WORLD, limits=Limits(bodies=6, ground_lookups=24)).posts) == 3
 
 
 def test_the_scene_builds_the_posts_where_they_stand(client):
@@ -212,10 +163,13 @@ def test_registered_leaves_the_registry_as_it_was():
         ({"section": "walls"}, "the world file has that top-level key already"),
         ({"section": "ground"}, "the world file has that top-level key already"),
         ({"section": "elements"}, "WorldConfig has an attribute of that name"),
-        ({"section": "extra"}, "WorldConfig has an attribute of that name"),
+        ({"section": "sections"}, "WorldConfig has an attribute of that name"),
+        ({"section": "ground_height"}, "WorldConfig has an attribute of that name"),
         ({"section": "Posts"}, "its section must be a lowercase name"),
         ({"prefix": "post1"}, "its entries' prefix 'post1' must be lowercase letters"),
         ({"keys": (*POST_KEYS, Key("h", float, 1.0, aliases=("height",)))}, "its keys name height more than once"),
+        ({"builder": "build_post"}, "make and builder must be functions"),
+        ({"ground": lambda post, x, y: post.height}, r"a kind that shapes the ground \(ground\) is made before"),
     ],
 )
 def test_a_kind_that_cannot_be_one_is_refused(changes, why):
@@ -228,12 +182,39 @@ def test_a_kind_that_cannot_be_one_is_refused(changes, why):
             pass
 
 
-def test_every_built_in_kind_has_a_builder_in_the_scene():
-    for kind in BUILT_IN:
-        assert callable(builder_of(kind)), kind.section
-    lost = replace(POSTS, builder="build_post")
-    with pytest.raises(LookupError, match=r"thorvald_sim\.scene has no builder 'build_post'"):
-        builder_of(lost)
+def _world_modules():
+    """(name, source file) of every module of the world package, and of the scene."""
+    found = [("thorvald_sim.world", thorvald_sim.world.__file__)]
+    for info in pkgutil.walk_packages(thorvald_sim.world.__path__, "thorvald_sim.world."):
+        found.append((info.name, importlib.util.find_spec(info.name).origin))
+    return [*found, ("thorvald_sim.scene", importlib.util.find_spec("thorvald_sim.scene").origin)]
+
+
+def test_a_built_in_kind_is_its_module_and_its_registry_line():
+    modules = [(kind, inspect.getmodule(kind.make)) for kind in BUILT_IN]
+    for kind, module in modules:
+        assert module.__name__ == f"thorvald_sim.world.kinds.{kind.section}", kind.section
+        assert kind in vars(module).values(), "the kind is its module's own"
+        # every function of the kind is its module's (a budget may be a shared one: bodies_each)
+        parts = (kind.make, kind.builder, kind.footprint, kind.check, kind.ground, kind.holes)
+        assert {f.__module__ for f in parts if f is not None} == {module.__name__}, kind.section
+    # the registry holds one line a kind, and every kind's module in its folder is registered
+    folder = os.path.dirname(kinds.__file__)
+    found = sorted(name[:-3] for name in os.listdir(folder) if name.endswith(".py") and name != "__init__.py")
+    assert found == sorted(kind.section for kind in BUILT_IN)
+    # nothing that loads or builds a world imports a kind's module but the registry (the kinds'
+    # package), nor one kind's module another's: a kind is not spread over the package's layers
+    names = {module.__name__ for _, module in modules}
+
+    def kind_modules(path, name):
+        imported = imported_names(path, name)
+        return {m for m in names if any(n == m or n.startswith(m + ".") for n in imported)}
+
+    for name, path in _world_modules():
+        if name != "thorvald_sim.world.kinds" and name not in names:
+            assert kind_modules(path, name) == set(), name
+    for _, module in modules:
+        assert kind_modules(module.__file__, module.__name__) == set(), module.__name__
 
 
 def test_the_keys_table_has_a_row_for_the_posts():
@@ -248,15 +229,22 @@ def test_the_keys_table_has_a_row_for_the_posts():
     assert "posts" not in keys_markdown()
 
 
-def test_a_limit_set_on_the_package_reaches_every_module_that_reads_it(monkeypatch):
-    # the grid budget is read by the height field's maker and by the image check
-    monkeypatch.setattr(world_module, "MAX_FIELD_POINTS", 10)
-    assert budgets.MAX_FIELD_POINTS == elements.MAX_FIELD_POINTS == 10
+def test_a_limit_passed_as_a_value_reaches_every_check_that_reads_it(tmp_path):
+    # the grid budget is read by the height field's maker and by its image's check
+    tight = Limits(field_points=10)
+    field = {"height_field": {"size_x": 1, "size_y": 1, "resolution": 0.25}}
     with pytest.raises(ConfigError) as e:
-        parse_world({"height_field": {"size_x": 1, "size_y": 1, "resolution": 0.25}})
+        parse_world(field, limits=tight)
     assert e.value.problems[0].rule == "makes 5 x 5 grid points; at most 10"
-    monkeypatch.undo()
-    assert budgets.MAX_FIELD_POINTS == elements.MAX_FIELD_POINTS == world_module.MAX_FIELD_POINTS == 1_000_000
+    Image.fromarray(np.zeros((4, 4), dtype=np.uint8)).save(tmp_path / "small.png")
+    image = {"height_field": {"size_x": 1, "size_y": 1, "image": "small.png"}}
+    with pytest.raises(ConfigError) as e:
+        parse_world(image, base_dir=str(tmp_path), limits=tight)
+    assert e.value.problems[0].rule == "makes 4 x 4 grid points (its pixels); at most 10"
+    # the defaults are left as they were: nothing was set on a module
+    assert LIMITS.field_points == Limits().field_points == 1_000_000
+    assert parse_world(field).height_field.grid_shape() == (5, 5)
+    assert parse_world(image, base_dir=str(tmp_path)).height_field.grid_shape() == (4, 4)
 
 
 def test_check_world_counts_posts_and_takes_their_footprints_into_the_extent(tmp_path):

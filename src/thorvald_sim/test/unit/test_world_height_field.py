@@ -11,7 +11,9 @@ import sim_test_helpers
 from PIL import Image
 
 from thorvald_sim.scene import build_scene
-from thorvald_sim.world import HeightField, load_world, parse_world, plant_positions, resolve_world
+from thorvald_sim.world import load_world, parse_world, resolve_world
+from thorvald_sim.world.kinds.height_field import HeightField
+from thorvald_sim.world.kinds.rows import plant_positions
 
 FIELD = {"size_x": 10.0, "size_y": 6.0}
 

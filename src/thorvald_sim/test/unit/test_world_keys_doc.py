@@ -1,14 +1,16 @@
 """The world file's keys are documented once: the table rendered from the registry of element
-kinds (:func:`thorvald_sim.world.keys_markdown`), which docs/worlds.md holds between its
+kinds (:func:`thorvald_sim.world.keys_table.keys_markdown`), which docs/worlds.md holds between its
 ``world-keys`` marker lines (``python -m thorvald_sim.world --update docs/worlds.md`` writes it)."""
 
 import os
 
 import pytest
 
-from thorvald_sim.world import BUILT_IN, GRAVITY_KEY, GROUND_KEYS, keys_markdown, top_level_keys
+from thorvald_sim.world import BUILT_IN, top_level_keys
 from thorvald_sim.world.__main__ import main
-from thorvald_sim.world.registry import KEYS_BEGIN, KEYS_END, with_keys_table
+from thorvald_sim.world.ground import GROUND_KEYS
+from thorvald_sim.world.keys_table import KEYS_BEGIN, KEYS_END, keys_markdown, with_keys_table
+from thorvald_sim.world.loader import GRAVITY_KEY
 
 WORLDS_MD = os.path.join(os.path.dirname(os.path.abspath(__file__)), *[".."] * 4, "docs", "worlds.md")
 

@@ -6,6 +6,7 @@ key, the value and the rule). Nothing here builds a scene of that size: a world 
 parsed only, which makes none of its plants or meshes."""
 
 import os
+import random
 import struct
 import time
 import zlib
@@ -16,35 +17,17 @@ import yaml
 from PIL import Image
 from sim_test_helpers import world_problems
 
-from thorvald_sim import world as world_module
 from thorvald_sim.scene import build_scene
-from thorvald_sim.world import (
-    HEIGHT_FIELD_KEYS,
-    MAX_BODIES,
-    MAX_FIELD_POINTS,
-    MAX_GROUND_LOOKUPS,
-    MAX_HOLES,
-    MAX_HOOPS,
-    MAX_IMAGE_BYTES,
-    MAX_LENGTH,
-    MAX_MESH_BYTES,
-    MAX_NOISE_POINTS,
-    MAX_PLANTS,
-    MAX_REACH,
-    MAX_TABLE_LEGS,
-    OBJECT_KEYS,
-    PATCH_KEYS,
-    POLYTUNNEL_KEYS,
-    RAIL_KEYS,
-    ROWS_KEYS,
-    SLOPE_KEYS,
-    WALL_KEYS,
-    ConfigError,
-    load_world,
-    parse_world,
-    plant_positions,
-    worlds_dir,
-)
+from thorvald_sim.world import LIMITS, ConfigError, Limits, limits, load_world, loader, parse_world, worlds_dir
+from thorvald_sim.world.kinds.height_field import HEIGHT_FIELD_KEYS
+from thorvald_sim.world.kinds.objects import OBJECT_KEYS
+from thorvald_sim.world.kinds.patches import PATCH_KEYS, soft_patches
+from thorvald_sim.world.kinds.polytunnels import POLYTUNNEL_KEYS
+from thorvald_sim.world.kinds.rails import RAIL_KEYS
+from thorvald_sim.world.kinds.rows import ROWS_KEYS, plant_positions
+from thorvald_sim.world.kinds.slopes import SLOPE_KEYS
+from thorvald_sim.world.kinds.walls import WALL_KEYS
+from thorvald_sim.world.rules import MAX_LENGTH, MAX_REACH
 
 CRATE = os.path.join(worlds_dir(), "meshes", "crate.obj")
 LENGTH_RULE = "must be in (0, 10000] [m]"
@@ -55,11 +38,13 @@ JUST_PAST = 10_000.001  # [m] a millimetre past MAX_LENGTH and MAX_REACH
 
 def test_the_limits_are_the_documented_ones():
     assert (MAX_REACH, MAX_LENGTH) == (10_000.0, 10_000.0)
-    assert (MAX_PLANTS, MAX_HOOPS, MAX_TABLE_LEGS, MAX_BODIES, MAX_HOLES) == (50_000, 2_000, 10_000, 2_000, 50)
-    assert (MAX_GROUND_LOOKUPS, MAX_FIELD_POINTS, MAX_NOISE_POINTS) == (2_000_000, 1_000_000, 1_000_000)
-    assert (MAX_IMAGE_BYTES, MAX_MESH_BYTES) == (32_000_000, 32_000_000)
+    d = LIMITS
+    assert (d.plants, d.hoops, d.table_legs, d.bodies, d.holes) == (50_000, 2_000, 10_000, 2_000, 50)
+    assert (d.ground_lookups, d.field_points, d.noise_points) == (2_000_000, 1_000_000, 1_000_000)
+    assert (d.image_bytes, d.mesh_bytes) == (32_000_000, 32_000_000)
+    assert Limits() == LIMITS
     for figure in ("50 000", "2000 over every polytunnel", "10 000 over every polytunnel", "2 000 000", "32 MB"):
-        assert figure in world_module.__doc__
+        assert figure in limits.__doc__
 
 
 # ---------------------------------------------------------------------------------------------
@@ -265,7 +250,7 @@ def test_hoops_at_and_past_the_limit():
     # 1999 m every 1 m: 1999 spacings, 2000 hoops
     tunnel = {"x": 0, "y": 0, "length": 1999, "hoop_spacing": 1, "crop": "none"}
     (parsed,) = parse_world({"polytunnels": {"polytunnel0": tunnel}}).polytunnels
-    assert len(parsed.hoop_stations()) == MAX_HOOPS
+    assert len(parsed.hoop_stations()) == LIMITS.hoops
     found = world_problems({"polytunnels": {"polytunnel0": {**tunnel, "length": 2000}}})
     assert found["polytunnels.polytunnel0.hoop_spacing"].rule == (
         "makes 2001 hoops over the world's polytunnels; at most 2000"
@@ -277,7 +262,7 @@ def test_table_legs_at_and_past_the_limit():
     # every 10 m (1001) and a plant every 0.25 m (39 996) stay inside their budgets
     tunnel = {"x": 0, "y": 0, "length": 9999, "hoop_spacing": 10, "tables": 1, "end_gap": 0, "leg_spacing": 1}
     (parsed,) = parse_world({"polytunnels": {"polytunnel0": tunnel}}).polytunnels
-    assert len(parsed.table_leg_stations()) * len(parsed.table_offsets()) == MAX_TABLE_LEGS
+    assert len(parsed.table_leg_stations()) * len(parsed.table_offsets()) == LIMITS.table_legs
     found = world_problems({"polytunnels": {"polytunnel0": {**tunnel, "length": 10_000}}})
     assert list(found) == ["polytunnels.polytunnel0.leg_spacing"]
     assert found["polytunnels.polytunnel0.leg_spacing"].rule == (
@@ -285,8 +270,8 @@ def test_table_legs_at_and_past_the_limit():
     )
 
 
-@pytest.mark.parametrize("budget", ["MAX_PLANTS", "MAX_HOOPS", "MAX_TABLE_LEGS"])
-def test_the_budgets_count_what_the_world_makes(monkeypatch, budget):
+@pytest.mark.parametrize("budget", ["plants", "hoops", "table_legs"])
+def test_the_budgets_count_what_the_world_makes(budget):
     # a world of every kind of plant and tunnel part, its counts from the value types themselves;
     # with the budget one below them, the refusal says exactly that count
     data = {
@@ -304,21 +289,19 @@ def test_the_budgets_count_what_the_world_makes(monkeypatch, budget):
     tunnels = world.polytunnels
     counts = {
         # places, gaps included (plant_positions leaves the gaps out)
-        "MAX_PLANTS": sum(r.count * r.plants_per_row for r in world.rows)
+        "plants": sum(r.count * r.plants_per_row for r in world.rows)
         + sum(len(t.plant_stations()) * len(t.table_offsets()) for t in tunnels),
-        "MAX_HOOPS": sum(len(t.hoop_stations()) for t in tunnels),
-        "MAX_TABLE_LEGS": sum(len(t.table_leg_stations()) * len(t.table_offsets()) for t in tunnels),
+        "hoops": sum(len(t.hoop_stations()) for t in tunnels),
+        "table_legs": sum(len(t.table_leg_stations()) * len(t.table_offsets()) for t in tunnels),
     }
     # row0: 3 x 11; row1: 2 x 4 (0.31 m every 0.1 m); tunnel0: 3 tables of 70 (17.5 m every 0.25 m),
     # tunnel1: 4 beds of 32 (8 m)
-    assert counts["MAX_PLANTS"] == 33 + 8 + 210 + 128
+    assert counts["plants"] == 33 + 8 + 210 + 128
     assert sum(len(line) for r in world.rows for line in plant_positions(r)) < 41, "the gaps are left out"
-    monkeypatch.setattr(world_module, budget, counts[budget] - 1)
     with pytest.raises(ConfigError) as e:
-        parse_world(data)
+        parse_world(data, limits=Limits(**{budget: counts[budget] - 1}))
     assert any(f"makes {counts[budget]} " in pr.rule for pr in e.value.problems)
-    monkeypatch.setattr(world_module, budget, counts[budget])
-    parse_world(data)
+    parse_world(data, limits=Limits(**{budget: counts[budget]}))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -355,7 +338,7 @@ def test_the_bodies_of_a_rows_entry_and_a_polytunnel():
 CRATE_OBJECT = {"shape": "mesh", "x": 10, "y": 10, "file": CRATE}
 
 
-def test_the_body_count_is_the_scenes(client, monkeypatch):
+def test_the_body_count_is_the_scenes(client):
     # one of everything (legs, a table-top tunnel and a tunnel without crop): the budget's count is
     # what build_scene makes
     data = {
@@ -373,9 +356,8 @@ def test_the_body_count_is_the_scenes(client, monkeypatch):
     scene = build_scene(client, parse_world(data))
     # 1 + 1 + 2 + 1 + 3 + (3 + 6) + 3 + 1, and the ground
     assert len(scene.bodies) == 22
-    monkeypatch.setattr(world_module, "MAX_BODIES", 21)
     with pytest.raises(ConfigError) as e:
-        parse_world(data)
+        parse_world(data, limits=Limits(bodies=21))
     assert [pr.rule[:26] for pr in e.value.problems] == ["makes 22 pybullet bodies o"]
 
 
@@ -387,14 +369,14 @@ def _patches(n, soft):
 
 
 def test_holes_at_and_past_the_limit():
-    assert len(parse_world(_patches(MAX_HOLES, soft=True)).soft_patches) == 1
-    found = world_problems(_patches(MAX_HOLES + 1, soft=True))
+    assert len(soft_patches(parse_world(_patches(LIMITS.holes, soft=True)).patches)) == 1
+    found = world_problems(_patches(LIMITS.holes + 1, soft=True))
     assert found["patches"].value == 51
     assert found["patches"].rule == ("makes 51 holes in the ground (one under every patch, as one is soft); at most 50")
     # without a soft patch there are no holes: as many patches as bodies allow
-    assert len(parse_world(_patches(MAX_HOLES + 1, soft=False)).patches) == 51
+    assert len(parse_world(_patches(LIMITS.holes + 1, soft=False)).patches) == 51
     # a soft kind made firm by its sinkage key makes no holes either
-    firm = _patches(MAX_HOLES + 1, soft=True)
+    firm = _patches(LIMITS.holes + 1, soft=True)
     firm["patches"]["patch0"]["sinkage"] = 0
     parse_world(firm)
 
@@ -430,8 +412,8 @@ def test_a_world_over_a_budget_searches_no_ground(monkeypatch):
     # budget (refused anyway) they do not: thousands of them among thousands of patches could take
     # minutes before the refusal
     searches = []
-    real = world_module._ground_height
-    monkeypatch.setattr(world_module, "_ground_height", lambda *a: searches.append(1) or real(*a))
+    real = loader.ground_height
+    monkeypatch.setattr(loader, "ground_height", lambda *a: searches.append(1) or real(*a))
     data = {
         "objects": {f"object{i}": {"shape": "sphere", "x": 0, "y": 0, "radius": 0.1} for i in range(3)},
         "polytunnels": {"polytunnel0": {"x": 0, "y": 50, "length": 10, "crop": "none"}},
@@ -485,7 +467,7 @@ def test_an_image_too_big_for_pil_is_one_clean_problem(tmp_path):
 
 def test_image_bytes_at_and_past_the_limit(tmp_path):
     # a 2 x 2 PNG with zeros after its end to the limit (sparse: no disk, nothing read but its header)
-    for name, size in (("at.png", MAX_IMAGE_BYTES), ("past.png", MAX_IMAGE_BYTES + 1)):
+    for name, size in (("at.png", LIMITS.image_bytes), ("past.png", LIMITS.image_bytes + 1)):
         Image.fromarray(np.array([[0, 255], [255, 0]], dtype=np.uint8)).save(tmp_path / name)
         with open(tmp_path / name, "r+b") as f:
             f.truncate(size)
@@ -511,20 +493,20 @@ def test_noise_lattice_at_and_past_the_limit():
 def test_the_noise_lattice_counted_is_the_one_made(monkeypatch):
     # the lattice _value_noise draws: one random number a point; counted through the generator
     made = []
-    real = world_module.random.Random
+    real = random.Random
 
     class Counting(real):
         def uniform(self, a, b):
             made.append(1)
             return super().uniform(a, b)
 
-    monkeypatch.setattr(world_module.random, "Random", Counting)
+    monkeypatch.setattr(random, "Random", Counting)
     field = {"size_x": 9, "size_y": 5, "resolution": 0.5, "amplitude": 0.1, "feature_length": 2}
     parse_world({"height_field": field}).height_field.heights()
     # x: -4.5 / 2 .. 4.5 / 2 = -2.25 .. 2.25: floor 2 - floor -3 + 2 = 7; y: -1.25 .. 1.25: 1 + 2 + 2 = 5
     assert len(made) == 7 * 5
-    monkeypatch.setattr(world_module, "MAX_NOISE_POINTS", 34)
-    assert world_problems({"height_field": field})["height_field.feature_length"].rule.startswith("makes 7 x 5 ")
+    found = world_problems({"height_field": field}, limits=Limits(noise_points=34))
+    assert found["height_field.feature_length"].rule.startswith("makes 7 x 5 ")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -561,11 +543,18 @@ def test_a_mesh_file_over_the_limit_is_refused_without_being_read(tmp_path):
 # The shipped worlds are well inside every budget
 # ---------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("name", sorted(f[:-5] for f in os.listdir(worlds_dir()) if f.endswith(".yaml")))
-def test_the_shipped_worlds_use_a_twentieth_of_each_budget_at_most(monkeypatch, name):
+def test_the_shipped_worlds_use_a_twentieth_of_each_budget_at_most(name):
     # as the module says: crop_rows' 2471 plants are the most (of 2500 here); farm_track's 6 patches
     # are 6 holes, an eighth of 50
-    budgets = ("MAX_PLANTS", "MAX_HOOPS", "MAX_TABLE_LEGS", "MAX_BODIES", "MAX_GROUND_LOOKUPS", "MAX_MESH_BYTES")
-    for budget in (*budgets, "MAX_FIELD_POINTS", "MAX_NOISE_POINTS"):
-        monkeypatch.setattr(world_module, budget, getattr(world_module, budget) // 20)
-    monkeypatch.setattr(world_module, "MAX_HOLES", MAX_HOLES // 8)
-    load_world(os.path.join(worlds_dir(), name + ".yaml"))
+    budgets = (
+        "plants",
+        "hoops",
+        "table_legs",
+        "bodies",
+        "ground_lookups",
+        "mesh_bytes",
+        "field_points",
+        "noise_points",
+    )
+    tight = Limits(**{budget: getattr(LIMITS, budget) // 20 for budget in budgets}, holes=LIMITS.holes // 8)
+    load_world(os.path.join(worlds_dir(), name + ".yaml"), tight)

@@ -12,10 +12,11 @@ import pytest
 import yaml
 from sim_test_helpers import world_problems
 
-from thorvald_sim import mesh_check, world
+from thorvald_sim import mesh_check
 from thorvald_sim.mesh_check import mesh_problem
 from thorvald_sim.scene import build_scene
 from thorvald_sim.world import ConfigError, load_world, parse_world, worlds_dir
+from thorvald_sim.world.kinds import objects as objects_kind
 
 CRATE = os.path.join(worlds_dir(), "meshes", "crate.obj")
 TRIANGLE = b"v 0 0 0\nv 1 0 0\nv 0 1 0\n"
@@ -123,7 +124,7 @@ def test_what_the_check_refuses_pybullet_cannot_load_either(client, tmp_path, na
 def test_a_file_named_by_many_objects_is_read_once(tmp_path, monkeypatch):
     (tmp_path / "cube.stl").write_bytes(MESHES["cube.stl"])
     read = []
-    monkeypatch.setattr(world, "mesh_problem", lambda path: read.append(path) or mesh_check.mesh_problem(path))
+    monkeypatch.setattr(objects_kind, "mesh_problem", lambda path: read.append(path) or mesh_check.mesh_problem(path))
     objects = {f"object{i}": {"shape": "mesh", "x": i, "y": 0, "file": "cube.stl"} for i in range(5)}
     assert len(parse_world({"objects": objects}, base_dir=str(tmp_path)).objects) == 5
     assert read == [str(tmp_path / "cube.stl")]

@@ -7,7 +7,8 @@ import pytest
 from sim_test_helpers import world_problems
 
 from thorvald_sim.scene import build_scene
-from thorvald_sim.world import ARCH_SEGMENTS, TABLE_DEPTH, load_world, parse_world, resolve_world
+from thorvald_sim.world import load_world, parse_world, resolve_world
+from thorvald_sim.world.kinds.polytunnels import ARCH_SEGMENTS, TABLE_DEPTH
 
 TUNNEL = {"x": 0.0, "y": 0.0, "length": 20.0}
 

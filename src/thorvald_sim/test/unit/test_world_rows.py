@@ -6,8 +6,11 @@ import pybullet as p
 import pytest
 from sim_test_helpers import ray_down, world_problems
 
-from thorvald_sim.scene import MAX_MESH_VERTICES, build_scene
-from thorvald_sim.world import ConfigError, Rows, Surface, load_world, parse_world, plant_positions, resolve_world
+from thorvald_sim.scene import build_scene
+from thorvald_sim.world import ConfigError, load_world, parse_world, resolve_world
+from thorvald_sim.world.bodies import MAX_MESH_VERTICES
+from thorvald_sim.world.kinds.rows import Rows, plant_positions
+from thorvald_sim.world.surfaces import Surface
 
 ROW = {"x": 1.0, "y": 2.0, "length": 3.0}
 

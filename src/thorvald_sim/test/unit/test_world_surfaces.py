@@ -1,7 +1,7 @@
-"""Surfaces that cost grip: the surface kinds (the numbers world.py documents), soft ground that sinks
-a wheel (a ground with holes under soft patches), and what pybullet makes of them: a ball and a
-rolling wheel sink by the documented amount and stay put, a coasting wheel slows on high rolling
-resistance, a driven one needs more torque there, and a sunk wheel still rolls r * omega."""
+"""Surfaces that cost grip: the surface kinds (the numbers thorvald_sim.world.surfaces documents), soft
+ground that sinks a wheel (a ground with holes under soft patches), and what pybullet makes of them: a
+ball and a rolling wheel sink by the documented amount and stay put, a coasting wheel slows on high
+rolling resistance, a driven one needs more torque there, and a sunk wheel still rolls r * omega."""
 
 import math
 import os
@@ -15,20 +15,10 @@ from thorvald_model.description import generate_urdf
 from thorvald_sim.robot import Pose2D, yaw_of
 from thorvald_sim.scene import build_scene
 from thorvald_sim.simulation import Simulation
-from thorvald_sim.world import (
-    MAX_SINKAGE,
-    PATCH_TOP,
-    REFERENCE_WHEEL_RADIUS,
-    SINKAGE_LOAD,
-    SOFT_DEPTH,
-    SURFACE_KINDS,
-    ConfigError,
-    Surface,
-    ground_pieces,
-    load_world,
-    parse_world,
-    resolve_world,
-)
+from thorvald_sim.world import ConfigError, load_world, parse_world, resolve_world
+from thorvald_sim.world.geometry import ground_pieces
+from thorvald_sim.world.kinds.patches import PATCH_TOP, SOFT_DEPTH, soft_patches
+from thorvald_sim.world.surfaces import MAX_SINKAGE, REFERENCE_WHEEL_RADIUS, SINKAGE_LOAD, SURFACE_KINDS, Surface
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 STD = os.path.join(HERE, "..", "..", "..", "thorvald_model", "config", "thorvald_ii_4wd4ws_std")
@@ -36,7 +26,7 @@ STD = os.path.abspath(os.path.join(STD, "thorvald_ii_4wd4ws_std.yaml"))
 G = 9.81  # [m/s^2], the worlds' gravity
 DT = 1.0 / 240  # [s], pybullet's default step and the simulator's
 
-# The module docstring's table: kind: (lateral friction, C_rr, rolling friction [m], sinkage [m])
+# thorvald_sim.world.surfaces' docstring's table: kind: (lateral friction, C_rr, rolling friction [m], sinkage [m])
 TABLE = {
     "tarmac": (0.9, 0.015, 0.003, 0.0),
     "concrete": (0.85, 0.012, 0.0024, 0.0),
@@ -94,7 +84,7 @@ def test_a_kind_names_the_numbers_of_the_ground_and_of_a_patch(kind):
         assert surface.kind == kind
     assert world.ground_rgba == SURFACE_KINDS[kind].rgba
     assert world.patches[0].rgba == SURFACE_KINDS[kind].rgba
-    assert world.soft_patches == (world.patches if sinkage > 0 else ())
+    assert soft_patches(world.patches) == (world.patches if sinkage > 0 else ())
 
 
 def test_a_key_beside_a_kind_overrides_its_number_and_nothing_else():
@@ -109,7 +99,7 @@ def test_a_key_beside_a_kind_overrides_its_number_and_nothing_else():
     mud = world.patches[0]
     assert mud.surface == Surface(0.35, 0.05, 0.01, 0.0, 0.0)
     assert (mud.surface.kind, mud.rgba) == ("mud", SURFACE_KINDS["mud"].rgba)
-    assert world.soft_patches == ()
+    assert soft_patches(world.patches) == ()
 
 
 def test_without_a_kind_everything_is_as_before():
@@ -359,7 +349,7 @@ def test_without_soft_patches_the_ground_is_the_plane_and_may_be_soft(client):
     assert p.getCollisionShapeData(ground, -1, physicsClientId=client)[0][2] == p.GEOM_PLANE
     assert p.getDynamicsInfo(ground, -1, physicsClientId=client)[9] == pytest.approx(500.0 / 0.015)
     for name in ("tarmac_gravel", "flat"):
-        assert not load_world(resolve_world(name)).soft_patches
+        assert not soft_patches(load_world(resolve_world(name)).patches)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -650,7 +640,7 @@ def test_tarmac_gravel_has_grass_and_mud_across_the_manoeuvre_on_its_plane(clien
             lateral, _, rolling, _ = TABLE[kind]
             # the kind's grip and rolling resistance, not its sinkage: the ground stays bullet's plane
             assert pa.surface == Surface(lateral, rolling, 0.0, 0.0, 0.0)
-    assert not world.soft_patches
+    assert not soft_patches(world.patches)
     scene = build_scene(client, world)
     assert p.getCollisionShapeData(scene.bodies["ground"], -1, physicsClientId=client)[0][2] == p.GEOM_PLANE
     # along the path (80 m): as the header says, about 15 m gravel, 5 m grass, 3 m mud
@@ -674,7 +664,7 @@ def test_farm_track_is_a_soft_field_with_a_track_through_a_muddy_gateway():
     assert world.ground.kind == "grass" and world.ground.sinkage == 0.004
     kinds = {pa.name: pa.surface.kind for pa in world.patches}
     assert sorted(set(kinds.values())) == ["gravel", "mud", "wet_grass"]
-    assert {pa.surface.kind for pa in world.soft_patches} == {"mud", "wet_grass"}
+    assert {pa.surface.kind for pa in soft_patches(world.patches)} == {"mud", "wet_grass"}
     # the track's centre line, x from 3 to 39 m, is gravel but for the gateway's mud from 15 to 19 m
     for k in range(360):
         x = 3.05 + k / 10  # not on an edge, where two patches meet

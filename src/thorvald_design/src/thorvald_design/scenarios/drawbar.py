@@ -27,7 +27,7 @@ import math
 from typing import Any, Dict, List, Mapping, Tuple
 
 from thorvald_model.schema import Key
-from thorvald_sim.world.values import SURFACE_KINDS
+from thorvald_sim.world.surfaces import SURFACE_KINDS
 
 from ..quasi_static import max_pull
 from .driving import SURFACE_RULE, SURFACES, as_simulated, flat_world, heading_hold, mean, rolling_offset

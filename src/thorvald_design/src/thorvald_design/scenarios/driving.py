@@ -13,7 +13,7 @@ import numpy as np
 
 from thorvald_model.errors import Problem
 from thorvald_model.layout import axle_lines
-from thorvald_sim.world.values import SURFACE_KINDS
+from thorvald_sim.world.surfaces import SURFACE_KINDS
 
 from ..metrics import Track
 from ..quasi_static import Layout

@@ -65,7 +65,7 @@ import math
 from typing import Any, Dict, List, Mapping, Tuple
 
 from thorvald_model.schema import Key, one_of
-from thorvald_sim.world.values import SURFACE_KINDS
+from thorvald_sim.world.surfaces import SURFACE_KINDS
 
 from ..quasi_static import gradeability
 from .driving import (

@@ -4,7 +4,7 @@ robot can make: how much headland it needs, and how many plants it runs over.
 The field: rows of plants along +x ending at x = 0 (``row_spacing`` apart, plants ``plant_width``
 wide every ``plant_spacing``, ``plant_height`` tall); the robot drives along row 0 (base_link over
 it, as a Thorvald straddles a row) towards the row ends and must come back along row ``next``. The
-plants are counted from the geometry (:func:`thorvald_sim.world.values.plant_positions`), not put in
+plants are counted from the geometry (:func:`thorvald_sim.world.kinds.rows.plant_positions`), not put in
 the physics: a leaf bends, it does not stop a robot. Each turn is driven by the robot's own
 base_driver core:
 
@@ -36,7 +36,7 @@ import numpy as np
 from thorvald_model.errors import Problem
 from thorvald_model.schema import Key, one_of
 from thorvald_sim.world import parse_world
-from thorvald_sim.world.values import plant_positions
+from thorvald_sim.world.kinds.rows import plant_positions
 
 from ..metrics import plants_touched
 from ..route import PurePursuit, line, path_of, turn

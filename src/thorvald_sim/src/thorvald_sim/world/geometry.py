@@ -1,32 +1,34 @@
-"""Ground geometry of a world: frames along an element, the ground's height under a point, and the
-ground with holes under the patches (:func:`ground_pieces`).
+"""Ground geometry of a world: frames along an element, the ground's height under a point from what
+shapes it (:func:`ground_height`), and the ground with holes (:func:`ground_pieces`).
 
 Pure maths on numbers and on the world's value types (read through their attributes): no pybullet.
 """
 
 import math
-from typing import List, Optional, Sequence, Tuple
+from typing import Any, Callable, List, Optional, Sequence, Tuple
 
 Point = Tuple[float, float]
 
-PATCH_TOP = 0.001  # [m] above the ground plane: a patch's top
-SOFT_DEPTH = 0.3  # [m] of a soft patch below its top: six times MAX_SINKAGE, so no wheel meets its bottom
 GROUND_THICKNESS = 0.1  # [m] of the pieces of a ground with holes
 GROUND_EXTENT = 1000.0  # [m] from the origin in x and y: a ground with holes ends there
 SOFT_PATCH_REACH = GROUND_EXTENT - 1.0  # [m]: a soft patch's corners within this of the origin in x and y
 
+# An element kind's ground function (ElementKind.ground: the height [m] it gives the ground at a point,
+# None where it gives none) and the kind's elements
+Shaper = Tuple[Callable[[Any, float, float], Optional[float]], Sequence[Any]]
 
-def _ground_height(height_field, slopes: Sequence, patches: Sequence, px: float, py: float) -> float:
-    """[m] of the ground at (px, py): the height field's (0 off it, or without one), the hills' and the
-    patches' tops, whichever is highest. The elements that shape the ground are these three kinds."""
-    z = 0.0
-    if height_field is not None:
-        z = height_field.height_at(px, py) or 0.0
-    for slope in slopes:
-        z = max(z, slope.height_at(px, py) or 0.0)
-    if any(patch.contains(px, py) for patch in patches):
-        z = max(z, PATCH_TOP)
-    return z
+
+def ground_height(shapers: Sequence[Shaper], px: float, py: float) -> float:
+    """[m] of the ground at (px, py): the highest of the heights the elements that shape it give
+    there (a height field its own, 0 off it; a hill its own, 0 off it; a patch its top, on it only),
+    0 where none gives any."""
+    z: Optional[float] = None
+    for height, elements in shapers:
+        for element in elements:
+            h = height(element, px, py)
+            if h is not None and (z is None or h > z):
+                z = h
+    return 0.0 if z is None else z
 
 
 def ground_pieces(holes: Sequence[Sequence[Point]], extent: float = GROUND_EXTENT) -> List[Tuple[Point, ...]]:
@@ -137,18 +139,24 @@ def _crossing_x(a: Tuple[Point, Point], b: Tuple[Point, Point]) -> Optional[floa
     return None
 
 
-def _to_local(dx: float, dy: float, yaw: float) -> Tuple[float, float]:
+def to_local(dx: float, dy: float, yaw: float) -> Tuple[float, float]:
     c, s = math.cos(yaw), math.sin(yaw)
     return c * dx + s * dy, -s * dx + c * dy
 
 
-def _along(x: float, y: float, yaw: float, u: float, v: float) -> Point:
+def along(x: float, y: float, yaw: float, u: float, v: float) -> Point:
     """The world point of (u, v) in a frame at (x, y) turned by yaw."""
     c, s = math.cos(yaw), math.sin(yaw)
     return x + c * u - s * v, y + s * u + c * v
 
 
-def _stations(start: float, end: float, spacing: float) -> Tuple[float, ...]:
+def rectangle(x: float, y: float, yaw: float, us: Sequence[float], vs: Sequence[float]) -> List[Point]:
+    """The corners [m] of the rectangle us[0]..us[1] by vs[0]..vs[1] in a frame at (x, y) turned by yaw
+    (an element's footprint)."""
+    return [along(x, y, yaw, u, v) for u in us for v in vs]
+
+
+def stations(start: float, end: float, spacing: float) -> Tuple[float, ...]:
     """Evenly spread points from start to end (both included), as near ``spacing`` apart as fits."""
     n = max(1, round((end - start) / spacing))
     return tuple(start + (end - start) * k / n for k in range(n + 1))

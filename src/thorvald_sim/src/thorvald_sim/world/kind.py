@@ -1,19 +1,23 @@
 """What a kind of world element is: :class:`ElementKind`, one entry of the registry
-(:mod:`thorvald_sim.world.registry`), and what its functions are given (:class:`Entry`,
+(:mod:`thorvald_sim.world.kinds`), and what its functions are given (:class:`Entry`,
 :class:`Context`).
 
 A kind is a section of the world file (``walls:``, entries ``wall0``, ``wall1``, ...; or one
 mapping, as ``height_field:``) with its keys, the function that makes an element's value from an
 entry's checked values (and reports the rules between its keys), what its entries take of the
-world's budgets, and the function that builds an element in pybullet (:mod:`thorvald_sim.scene`).
-The loader and the scene iterate the registry: a new kind is its module and one registry line.
+world's budgets, where an element lies on the ground, and the function that builds it in pybullet.
+All of them live in the kind's own module (:mod:`thorvald_sim.world.kinds.walls`, ...); the loader,
+the scene and ``check_world`` iterate the registry: a new kind is its module and one registry line.
 """
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, NamedTuple, Optional, Sequence, Tuple
 
 from thorvald_model.errors import Problem
 from thorvald_model.schema import Key
+
+from .geometry import Point
+from .limits import LIMITS, Budget, Limits
 
 
 class Entry(NamedTuple):
@@ -34,11 +38,12 @@ class Context:
     base_dir: str  # the folder relative paths (meshes, images) are taken from
     problems: List[Problem]  # every problem found so far; a kind's functions add theirs here
     ground: Any  # the ground's Surface
+    limits: Limits = LIMITS  # the budgets the world is held to (a maker checks those it counts itself)
     made: Dict[str, Tuple[Any, ...]] = field(default_factory=dict)  # values made so far, by section
     # Whether a budget is broken: the world is refused anyway, and nothing searches for the ground
     over_budget: bool = False
-    # [m] the ground's height under (x, y): the height field, hills and patches once they are made
-    # (0 before, and in a world over its budgets)
+    # [m] the ground's height under (x, y): the kinds that shape it once they are made (0 before, and
+    # in a world over its budgets)
     ground_at: Callable[[float, float], float] = lambda x, y: 0.0
     # (key path, value, absolute path) of the mesh files the objects name, read by the objects' check
     meshes: List[Tuple[str, Any, str]] = field(default_factory=list)
@@ -60,24 +65,33 @@ class ElementKind:
     a section's entry), reporting the rules between its keys to ``context.problems``; None leaves
     it out (its problem reported).
     builder(client, world, element, name, bodies): adds the element's pybullet bodies to ``bodies``
-    under ``name`` (:meth:`body_name`), or ``name.<part>`` for several; a string names a function of
-    :mod:`thorvald_sim.scene`, so that this pure side never imports pybullet.
+    under ``name`` (:meth:`body_name`), or ``name.<part>`` for several. It calls pybullet through
+    :data:`thorvald_sim.world.bodies.p`, which imports it when a scene is first built, so that the
+    kind's module stays pure to whatever only loads worlds.
     budget(section, entries, searched): what the entries take of the world's budgets, by budget name
-    (:data:`thorvald_sim.world.budgets.BUDGETS`): (key path, value, amount) shares; ``searched`` is
-    what one ground look-up searches (the ground, every hill and patch).
+    (:data:`thorvald_sim.world.limits.BUDGETS`): (key path, value, amount) shares; ``searched`` is
+    what one ground look-up searches (the ground, and every entry of the kinds that shape it).
     check(elements, context): the rules between the section's elements, and with the rest of the
     world (what ``context.made`` holds), once all are made.
     footprint(element): the points [m] of a box around it on the ground (the world's extent, in
-    ``check_world``; :mod:`thorvald_sim.world.footprints`). counted: how ``check_world`` counts the
-    section's entries, one and many ("hill", "hills").
+    ``check_world``). counted: how ``check_world`` counts the section's entries, one and many
+    ("hill", "hills").
+    ground(element, x, y): for a kind that shapes the ground others stand on (a hill, a patch, a
+    height field), the height [m] the element gives it at (x, y), None where it gives none: the
+    ground is the highest there (:func:`thorvald_sim.world.geometry.ground_height`). Such a kind is
+    made before the budgets (``on_ground`` False).
+    replaces_ground: the kind's element takes the ground plane's place (a height field): the scene
+    builds no plane then, and a ground look-up searches it as the ground.
+    holes(elements): the polygons [m] (corners counter-clockwise) the section's elements need cut out
+    of the ground (soft patches sink into theirs): the scene builds the ground in pieces around them.
     """
 
     section: str  # the top-level key: "walls"
     prefix: Optional[str]  # its entries' name: "wall" for wall0, wall1, ...; None: one mapping
     keys: Tuple[Key, ...]
     make: Callable[[Entry, Context], Any]
-    builder: Union[str, Builder]
-    budget: Optional[Callable[[str, Sequence[Entry], int], Mapping[str, Sequence[Tuple[str, Any, float]]]]] = None
+    builder: Builder
+    budget: Optional[Budget] = None
     check: Optional[Callable[[Tuple[Any, ...], Context], None]] = None
     # False: part of what others stand on (or beside it): made while the file is read, before the
     # budgets; True: made after them, each on the ground under it (context.ground_at)
@@ -86,8 +100,11 @@ class ElementKind:
     # the defaults a key's own cannot say (a colour, a surface kind's number), by key, for the table
     defaults: Mapping[str, str] = field(default_factory=dict)
     body: Optional[str] = None  # the body's name of a single mapping (default: its section)
-    footprint: Optional[Callable[[Any], Sequence[Tuple[float, float]]]] = None
+    footprint: Optional[Callable[[Any], Sequence[Point]]] = None
     counted: Tuple[str, str] = ()  # ("wall", "walls"); default: the prefix and the section
+    ground: Optional[Callable[[Any, float, float], Optional[float]]] = None
+    replaces_ground: bool = False
+    holes: Optional[Callable[[Tuple[Any, ...]], Sequence[Sequence[Point]]]] = None
 
     @property
     def single(self) -> bool:

@@ -7,49 +7,54 @@ Every problem is collected with its dotted key path, value and rule, and raised 
 
 import glob
 import os
-from dataclasses import fields
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Mapping, Optional, Sequence
 
 from thorvald_model.errors import MISSING, ConfigError, Problem
 from thorvald_model.resources import package_folder
-from thorvald_model.schema import check_top_level, parse_entry, parse_scalar, parse_section, read_yaml_file
-
-from .budgets import budget_problems
-from .geometry import _ground_height
-from .keys import (
-    DESCRIPTION_KEY,
-    GRAVITY_KEY,
-    GROUND_DEFAULTS,
-    GROUND_KEYS,
-    RGBA_KEY,
-    RGBA_RULE,
-    WHAT,
-    _kind_colour,
-    _surface_of,
+from thorvald_model.schema import (
+    POSITIVE,
+    Key,
+    check_top_level,
+    parse_entry,
+    parse_scalar,
+    parse_section,
+    read_yaml_file,
 )
+
+from .config import WorldConfig
+from .geometry import ground_height
+from .ground import parse_ground
 from .kind import Context, ElementKind, Entry
-from .registry import element_kinds, top_level_keys
-from .values import RGBA_TARMAC, Rgba, Surface, WorldConfig
+from .kinds import element_kinds, top_level_keys
+from .limits import LIMITS, Limits, budget_problems
+from .rules import RGBA_KEY, WHAT, take_colour, take_colours
 
 # The package folder when this module runs from the source tree (or the devel space, which relays
 # to it); in an install space the worlds are under share/thorvald_sim instead.
 PACKAGE_DIR = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
+# The top-level keys that are neither the ground nor an element kind
+GRAVITY_KEY = Key("gravity", float, 9.81, **POSITIVE)
+DESCRIPTION_KEY = Key("description", str, "")
 
-def load_world(path: str) -> WorldConfig:
+
+def load_world(path: str, limits: Limits = LIMITS) -> WorldConfig:
     """Loads and validates a world file; raises ConfigError naming every problem.
 
     A file that cannot be read at all (missing, a directory, not text, not YAML) raises a
     ConfigError with one problem at the top level, which formats as one line. Relative paths in
-    the file (meshes, images) are from the file's folder.
+    the file (meshes, images) are from the file's folder. limits: the budgets it is held to.
     """
-    return parse_world(read_yaml_file(path, WHAT), path, os.path.dirname(os.path.abspath(path)))
+    return parse_world(read_yaml_file(path, WHAT), path, os.path.dirname(os.path.abspath(path)), limits)
 
 
-def parse_world(data: Any, source: str = "<world>", base_dir: Optional[str] = None) -> WorldConfig:
+def parse_world(
+    data: Any, source: str = "<world>", base_dir: Optional[str] = None, limits: Limits = LIMITS
+) -> WorldConfig:
     """Validates an already parsed world (a YAML document or a ROS parameter tree).
 
     base_dir: the folder relative paths (meshes, images) are taken from; default the current one.
+    limits: the budgets the world is held to (:class:`~thorvald_sim.world.limits.Limits`).
     """
     base_dir = os.path.abspath(base_dir or os.getcwd())
     problems: List[Problem] = []
@@ -60,42 +65,39 @@ def parse_world(data: Any, source: str = "<world>", base_dir: Optional[str] = No
     # coercion and rules as every other key; their paths are the bare key names.
     gravity = parse_scalar(data, GRAVITY_KEY, problems)
     description = parse_scalar(data, DESCRIPTION_KEY, problems)
-    ground, ground_colour = _ground(data, problems)
+    ground, ground_colour = parse_ground(data, problems)
 
     # The kinds the others stand on (or beside) are made as they are read; the budgets are checked
     # before anything that grows with them is made. A world over them is refused anyway: its
     # objects, tunnels and walls take the plane's height, without a search.
-    context = Context(data, base_dir, problems, ground)
+    context = Context(data, base_dir, problems, ground, limits)
     entries: Dict[str, List[Entry]] = {}
     for kind in kinds:
         entries[kind.section] = _entries(kind, data, problems)
         if not kind.on_ground:
             _make(kind, entries[kind.section], context)
-    context.over_budget = budget_problems(kinds, entries, problems)
+    context.over_budget = budget_problems(kinds, entries, problems, limits)
     if not context.over_budget:
-        height_field, slopes, patches = context.single("height_field"), context.made["slopes"], context.made["patches"]
-        context.ground_at = lambda px, py: _ground_height(height_field, slopes, patches, px, py)
+        shapers = tuple((kind.ground, context.made[kind.section]) for kind in kinds if kind.ground is not None)
+        context.ground_at = lambda px, py: ground_height(shapers, px, py)
     for kind in kinds:
         if kind.on_ground:
             _make(kind, entries[kind.section], context)
 
     if problems:
         raise ConfigError(source, problems, WHAT)
-    base = dict(source=source, gravity=gravity, description=description, ground=ground, ground_rgba=ground_colour)
-    return _world(kinds, context, base)
-
-
-def _ground(data: Mapping, problems: List[Problem]) -> Tuple[Surface, Rgba]:
-    """The ground's surface and colour. A missing ground, or an empty ``ground:`` (YAML null),
-    means every default, as for sections."""
-    raw_ground = data.get("ground")
-    raw_ground = {} if raw_ground is None else raw_ground
-    raw_ground, ground_colour = _take_colour(raw_ground, "ground", None, problems)
-    ground_values = parse_entry(raw_ground, "ground", GROUND_KEYS, problems)
-    if ground_values is None:
-        ground_values = {k.name: k.default for k in GROUND_KEYS}
-    ground = _surface_of(ground_values, GROUND_DEFAULTS)
-    return ground, ground_colour or _kind_colour(ground) or RGBA_TARMAC
+    sections = tuple(
+        (kind.section, context.single(kind.section) if kind.single else context.made[kind.section]) for kind in kinds
+    )
+    return WorldConfig(
+        source=source,
+        gravity=gravity,
+        ground=ground,
+        description=description,
+        ground_rgba=ground_colour,
+        sections=sections,
+        shapers=tuple((kind.section, kind.ground) for kind in kinds if kind.ground is not None),
+    )
 
 
 def _entries(kind: ElementKind, data: Mapping, problems: List[Problem]) -> List[Entry]:
@@ -106,14 +108,14 @@ def _entries(kind: ElementKind, data: Mapping, problems: List[Problem]) -> List[
     if kind.single:
         if section is None:
             return []
-        raw, colour = _take_colour(section, kind.section, None, problems) if coloured else (section, None)
+        raw, colour = take_colour(section, kind.section, None, problems) if coloured else (section, None)
         values = parse_entry(raw, kind.section, kind.keys, problems)
         if values is None:
             return []
         if coloured:
             values["rgba"] = colour
         return [Entry(kind.section, 0, values, section, kind.section)]
-    raw, colours = _take_colours(section, kind.section, problems) if coloured else (section, {})
+    raw, colours = take_colours(section, kind.section, problems) if coloured else (section, {})
     found = []
     for name, index, values in parse_section(raw, kind.section, kind.prefix, kind.keys, problems):
         if coloured:
@@ -130,60 +132,9 @@ def _make(kind: ElementKind, entries: Sequence[Entry], context: Context) -> None
         kind.check(made, context)
 
 
-def _world(kinds: Sequence[ElementKind], context: Context, base: Mapping[str, Any]) -> WorldConfig:
-    """The world of base (its fields that are no kind's) and the made elements: each kind's in its
-    field of WorldConfig (a single mapping's value or None), or else in ``extra``."""
-    names = {f.name for f in fields(WorldConfig)}
-    own: Dict[str, Any] = {}
-    extra: List[Tuple[str, Any]] = []
-    for kind in kinds:
-        made = context.single(kind.section) if kind.single else context.made[kind.section]
-        if kind.section in names:
-            own[kind.section] = made
-        else:
-            extra.append((kind.section, made))
-    return WorldConfig(**base, **own, extra=tuple(extra))
-
-
-# ---------------------------------------------------------------------------------------------
-# Colours (rgba is a list, which the schema's keys do not take: checked here, and "" in the entry)
-# ---------------------------------------------------------------------------------------------
 def _raw_entry(section: Any, name: str) -> Mapping:
     entry = section.get(name) if isinstance(section, Mapping) else None
     return entry if isinstance(entry, Mapping) else {}
-
-
-def _colour(value: Any) -> Optional[Rgba]:
-    """The colour a list of 3 or 4 numbers in [0, 1] gives (alpha 1 if left out); None if it is not one."""
-    if not isinstance(value, (list, tuple)) or len(value) not in (3, 4):
-        return None
-    numbers = []
-    for v in value:
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v <= 1.0:
-            return None
-        numbers.append(float(v))
-    return (*numbers, 1.0) if len(numbers) == 3 else tuple(numbers)
-
-
-def _take_colour(entry: Any, path: str, default: Rgba, problems: List[Problem]) -> Tuple[Any, Rgba]:
-    """The entry with its rgba, checked here, replaced by "" for parse_entry, and the colour."""
-    if not isinstance(entry, Mapping) or "rgba" not in entry:
-        return entry, default
-    colour = _colour(entry["rgba"])
-    if colour is None:
-        problems.append(Problem(f"{path}.rgba", entry["rgba"], RGBA_RULE))
-    return {**entry, "rgba": ""}, colour or default
-
-
-def _take_colours(section: Any, key: str, problems: List[Problem]) -> Tuple[Any, Dict[str, Optional[Rgba]]]:
-    """The section with each entry's rgba taken out (as :func:`_take_colour`), and the colours by entry."""
-    if not isinstance(section, Mapping):
-        return section, {}
-    clean, colours = {}, {}
-    for name, entry in section.items():
-        clean[name], colour = _take_colour(entry, f"{key}.{name}", None, problems)
-        colours[str(name)] = colour
-    return clean, colours
 
 
 # ---------------------------------------------------------------------------------------------

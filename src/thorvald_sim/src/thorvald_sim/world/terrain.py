@@ -1,5 +1,5 @@
 """Terrain: a height field's grid of heights from a grey-scale image, random bumps and ruts, flat
-around the origin (:func:`_field_heights`), and what its image and noise cost, counted before they
+around the origin (:func:`field_heights`), and what its image and noise cost, counted before they
 are made.
 
 numpy and PIL are imported when a field is made, so that importing the world stays cheap. No pybullet.
@@ -14,12 +14,12 @@ FLAT_BLEND = 1.0  # [m] over which a height field rises from its flat disc to fu
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
-def _points(size: float, resolution: float) -> int:
+def points(size: float, resolution: float) -> int:
     """Grid points along a side of size [m], as near resolution [m] apart as fits (at least 2)."""
     return max(2, round(size / resolution) + 1)
 
 
-def _image_levels(path: str):
+def image_levels(path: str):
     """The image's grey levels in [0, 1] (numpy, rows from the -y edge); ValueError if it cannot be read."""
     import numpy as np  # noqa: PLC0415
     from PIL import Image, UnidentifiedImageError  # noqa: PLC0415
@@ -40,8 +40,8 @@ def _image_levels(path: str):
     return levels
 
 
-def _field_heights(hf):
-    """The heights [m] of a height field (a thorvald_sim.world.values.HeightField) on its grid."""
+def field_heights(hf):
+    """The heights [m] of a height field (a :class:`~thorvald_sim.world.kinds.height_field.HeightField`) on its grid."""
     import numpy as np  # noqa: PLC0415
 
     nx, ny = hf.grid_shape()
@@ -91,7 +91,7 @@ def _smoothstep(t):
     return t * t * (3.0 - 2.0 * t)
 
 
-def _image_size(path: str) -> Tuple[int, int]:
+def image_size(path: str) -> Tuple[int, int]:
     """(width, height) of the image from its header, without decoding it; ValueError if it cannot be read.
 
     A PNG's are read here (its IHDR chunk: PIL refuses a PNG of more than 179 million pixels with a
@@ -115,7 +115,7 @@ def _image_size(path: str) -> Tuple[int, int]:
         raise ValueError(f"cannot read the image: {e}") from None
 
 
-def _noise_lattice(size: float, feature_length: float) -> float:
+def noise_lattice(size: float, feature_length: float) -> float:
     """Lattice points along one side of a field's noise (as :func:`_value_noise` makes them)."""
     half = size / 2 / feature_length
     return half * 2 + 3 if half >= 1e15 else float(math.floor(half) - math.floor(-half) + 2)
