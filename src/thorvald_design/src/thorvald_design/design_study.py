@@ -7,7 +7,9 @@ candidate and scenario) go to N worker processes (default: the machine's cores),
 pybullet client, a progress bar on the terminal saying which candidate and scenario run; each run's
 result lands in ``DIR/results.json`` as it ends (so nothing is lost to an interruption, and
 ``--resume`` skips the runs already there), and at the end ``DIR/results.csv`` and a table on the
-terminal.
+terminal. Anything else the package refuses (:class:`thorvald_design.errors.DesignError`) ends the
+command with one line and exit 2, as does a file it cannot write; a run never does (what breaks in
+it is its result, ``"failed: ..."``).
 
 No ROS master: the runs use the simulator library's runner.
 """
@@ -22,10 +24,9 @@ from typing import List, Optional
 
 from tqdm import tqdm
 
-from thorvald_model.errors import ConfigError
-
+from .errors import DesignError, StudyError
 from .report import write_report
-from .report_table import results_table, write_csv
+from .report.table import results_table, write_csv
 from .runs import Job, done, empty_results, merge, prepare, read_results, run_one, write_json, write_results
 from .search import run_search, search_table
 from .study import load_study
@@ -60,10 +61,23 @@ def main(argv: Optional[List[str]] = None) -> int:
         print("design_study: --jobs must be >= 0 (0: the cores)", file=sys.stderr)
         return 2
     try:
-        study = load_study(args.study)
-    except ConfigError as e:
+        return _study(args)
+    except StudyError as e:  # every problem of the file, a line each (the robot files' format)
         print(e, file=sys.stderr)
-        return 2
+    except DesignError as e:
+        print(f"design_study: {_one_line(e)}", file=sys.stderr)
+    except OSError as e:  # DIR or a file in it that cannot be written
+        print(f"design_study: {e.filename or args.out}: {e.strerror or _one_line(e)}", file=sys.stderr)
+    return 2
+
+
+def _one_line(e: BaseException) -> str:
+    return " ".join(str(e).split()) or type(e).__name__
+
+
+def _study(args) -> int:
+    """The study of the command line: its runs, results, table and report; the exit code."""
+    study = load_study(args.study)
     if args.optimise:
         if study.optimise is None:
             print(f"{args.study}: --optimise needs an optimise: section (docs/design-studies.md)", file=sys.stderr)

@@ -21,6 +21,8 @@ import numpy as np
 
 from thorvald_model.motors import Motor, electrical_power, winding_current
 
+from .errors import EnergyError
+
 ArrayLike = Union[float, Sequence[float], np.ndarray]
 SECONDS_PER_HOUR = 3600.0
 # a run that used less than this fraction of the capacity used nothing (rounding of regeneration that gives
@@ -44,7 +46,7 @@ class Battery:
         )
         for name, ok, rule in rules:
             if not (ok and math.isfinite(getattr(self, name))):
-                raise ValueError(f"battery: {name} {getattr(self, name)!r}: must be {rule}")
+                raise EnergyError(f"battery: {name} {getattr(self, name)!r}: must be {rule}")
 
     @property
     def max_power(self) -> float:
@@ -100,14 +102,14 @@ def battery_current(battery: Battery, power_w: ArrayLike) -> Union[float, np.nda
     I = 2 P / (V + sqrt(V^2 - 4 R_i P)), the form computed: free of the cancellation for small R_i P,
     and P / V at R_i = 0 exactly. The square root is real only for P <= V^2 / (4 R_i), the most the
     battery can deliver (at I = V / (2 R_i), half its voltage lost inside): a larger load cannot be
-    supplied, ValueError with the figures. For P < 0 the same formula gives the charging current
+    supplied, EnergyError with the figures. For P < 0 the same formula gives the charging current
     I < 0 (the charger must push the terminals above V)."""
     p = np.asarray(power_w, dtype=float)
     v, r = battery.voltage, battery.internal_resistance
     too_much = p > battery.max_power
     if np.any(too_much):
         worst = float(np.max(p[too_much]))
-        raise ValueError(
+        raise EnergyError(
             f"battery: a load of {worst:.1f} W is more than the battery can deliver: "
             f"V^2 / (4 R_i) = {v:.2f}^2 / (4 * {r:.4f}) = {battery.max_power:.1f} W"
         )
@@ -124,13 +126,13 @@ def parallel(batteries: Sequence[Battery]) -> Battery:
     must have the same one) with R = 0."""
     batteries = list(batteries)
     if not batteries:
-        raise ValueError("parallel: no batteries")
+        raise EnergyError("parallel: no batteries")
     capacity = sum(b.capacity_ah for b in batteries)
     ideal = [b for b in batteries if b.internal_resistance == 0.0]
     if ideal:
         voltages = sorted({b.voltage for b in ideal})
         if len(voltages) > 1:
-            raise ValueError(f"parallel: ideal batteries (R_i = 0) of different voltages {voltages} V short-circuit")
+            raise EnergyError(f"parallel: ideal batteries (R_i = 0) of different voltages {voltages} V short-circuit")
         return Battery(capacity, voltages[0], 0.0)
     conductance = sum(1.0 / b.internal_resistance for b in batteries)
     voltage = sum(b.voltage / b.internal_resistance for b in batteries) / conductance
@@ -200,18 +202,18 @@ def energy_use(
       NOTHING_USED * capacity: nothing was used, or regeneration gave back as much as was drawn)."""
     t = np.asarray(t, dtype=float).reshape(-1)
     if t.size < 2:
-        raise ValueError(f"energy_use: {t.size} times; integrating needs at least 2")
+        raise EnergyError(f"energy_use: {t.size} times; integrating needs at least 2")
     if np.any(np.diff(t) < 0.0):
-        raise ValueError("energy_use: times must not decrease")
+        raise EnergyError("energy_use: times must not decrease")
     duration = float(t[-1] - t[0])
     if duration <= 0.0:
-        raise ValueError("energy_use: the times span no time")
+        raise EnergyError("energy_use: the times span no time")
     if not 0.0 < start_soc <= 1.0:
-        raise ValueError(f"energy_use: start_soc {start_soc}: must be in (0, 1]")
+        raise EnergyError(f"energy_use: start_soc {start_soc}: must be in (0, 1]")
     if distance_m < 0.0:
-        raise ValueError(f"energy_use: distance_m {distance_m}: must be >= 0")
+        raise EnergyError(f"energy_use: distance_m {distance_m}: must be >= 0")
     if area_ha is not None and area_ha <= 0.0:
-        raise ValueError(f"energy_use: area_ha {area_ha}: must be > 0 (or None)")
+        raise EnergyError(f"energy_use: area_ha {area_ha}: must be > 0 (or None)")
     pack = parallel(batteries)
 
     def series(name: str, values: ArrayLike) -> np.ndarray:
@@ -219,7 +221,7 @@ def energy_use(
         try:
             return np.broadcast_to(a, t.shape)
         except ValueError:
-            raise ValueError(f"energy_use: {name} has {a.size} values for {t.size} times") from None
+            raise EnergyError(f"energy_use: {name} has {a.size} values for {t.size} times") from None
 
     motors = [(name, series(f"motor {name!r}", p)) for name, p in powers_by_motor.items()]
     hotel = series("hotel_load_w", hotel_load_w)
@@ -227,7 +229,7 @@ def energy_use(
     too_much = total > pack.max_power
     if np.any(too_much):
         i = int(np.argmax(too_much))
-        raise ValueError(
+        raise EnergyError(
             f"energy_use: at t = {t[i]:.3f} s the load is {total[i]:.1f} W, more than the pack can deliver "
             f"({pack.voltage:.2f} V, {pack.internal_resistance:.4f} ohm: at most {pack.max_power:.1f} W)"
         )

@@ -21,6 +21,8 @@ from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
+from .errors import MetricError
+
 # Kasa's algebraic fit is exact for exact points; Gauss-Newton then refines it to the geometric
 # least-squares circle, which converges in a few steps from so close a start
 GAUSS_NEWTON_STEPS = 10
@@ -55,14 +57,14 @@ class Track:
             if n is None:
                 n = array.size
             elif array.size != n:
-                raise ValueError(f"track: {name} has {array.size} values, t has {n}")
+                raise MetricError(f"track: {name} has {array.size} values, t has {n}")
             if not np.all(np.isfinite(array)):
-                raise ValueError(f"track: {name} has a value that is not finite")
+                raise MetricError(f"track: {name} has a value that is not finite")
             object.__setattr__(self, name, array)
         if n == 0:
-            raise ValueError("track: no poses")
+            raise MetricError("track: no poses")
         if np.any(np.diff(self.t) < 0.0):
-            raise ValueError("track: times must not decrease")
+            raise MetricError("track: times must not decrease")
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -71,7 +73,7 @@ class Track:
         """The poses with t_start <= t <= t_end (e.g. the steady part of a turn)."""
         keep = (self.t >= t_start) & (self.t <= t_end)
         if not np.any(keep):
-            raise ValueError(f"track: no pose between t = {t_start} s and {t_end} s")
+            raise MetricError(f"track: no pose between t = {t_start} s and {t_end} s")
 
         def cut(a):
             return None if a is None else a[keep]
@@ -107,7 +109,7 @@ def distance_between(track: Track, i: int = 0, j: int = -1) -> float:
 
 def fit_circle(xs, ys) -> Tuple[float, float, float, float]:
     """The circle through the points (xs, ys) in the least-squares sense: (cx, cy, radius, rms) [m],
-    rms the root mean square of the points' distances from the circle. ValueError for fewer than 3
+    rms the root mean square of the points' distances from the circle. MetricError for fewer than 3
     points or points on a line (or all on one point).
 
     Kasa's algebraic fit first: a circle is x^2 + y^2 + D x + E y + F = 0, linear in (D, E, F), so
@@ -121,16 +123,16 @@ def fit_circle(xs, ys) -> Tuple[float, float, float, float]:
     x = np.asarray(xs, dtype=float).reshape(-1)
     y = np.asarray(ys, dtype=float).reshape(-1)
     if x.size != y.size:
-        raise ValueError(f"fit_circle: {x.size} x values, {y.size} y values")
+        raise MetricError(f"fit_circle: {x.size} x values, {y.size} y values")
     if x.size < 3:
-        raise ValueError(f"fit_circle: {x.size} points; a circle needs at least 3")
+        raise MetricError(f"fit_circle: {x.size} points; a circle needs at least 3")
     mx, my = float(np.mean(x)), float(np.mean(y))
     u, v = x - mx, y - my
     # the singular values of the centred points: their spread along and across the principal
     # direction; none across (relative to along) means a line, none at all one point
     spread = np.linalg.svd(np.column_stack([u, v]), compute_uv=False)
     if spread[0] == 0.0 or spread[1] <= COLLINEAR * spread[0]:
-        raise ValueError(f"fit_circle: the {x.size} points lie on a line; no circle is determined")
+        raise MetricError(f"fit_circle: the {x.size} points lie on a line; no circle is determined")
     scale = float(spread[0]) / math.sqrt(x.size)  # the points' RMS distance from their mean
     u, v = u / scale, v / scale
     a = np.column_stack([u, v, np.ones_like(u)])
@@ -201,11 +203,11 @@ def turning_diameters(
       farthest from any centre are vertices (the distance from a point is convex along an edge, so
       its maximum on the edge is at an end): the vertices are enough.
 
-    ValueError when the origin's path is a straight line (not a turn)."""
+    MetricError when the origin's path is a straight line (not a turn)."""
     if not wheel_contacts:
-        raise ValueError("turning_diameters: no wheel contacts")
+        raise MetricError("turning_diameters: no wheel contacts")
     if len(track) < 3:
-        raise ValueError(f"turning_diameters: {len(track)} poses; a turn needs at least 3")
+        raise MetricError(f"turning_diameters: {len(track)} poses; a turn needs at least 3")
     mx, my = float(np.mean(track.x)), float(np.mean(track.y))
     spin = float(np.max(np.hypot(track.x - mx, track.y - my))) <= spin_tolerance
     if spin:
@@ -213,8 +215,8 @@ def turning_diameters(
     else:
         try:
             cx, cy, _, _ = fit_circle(track.x, track.y)
-        except ValueError as error:
-            raise ValueError(f"turning_diameters: the track is not a turn ({error})") from None
+        except MetricError as error:
+            raise MetricError(f"turning_diameters: the track is not a turn ({error})") from None
         centre = (cx, cy)
 
     def radius(px: float, py: float) -> Tuple[float, float]:
@@ -229,32 +231,6 @@ def turning_diameters(
     # the outermost point: the outer wheel's contact unless a point of the outline is further out
     clearance, point = max([(outer[1], outer[3])] + [(o[0], o[2]) for o in others], key=lambda c: c[0])
     return TurningDiameters(2.0 * outer[1], 2.0 * clearance, centre, outer[0], spin, spread, point)
-
-
-def convex_hull(points: Sequence[Tuple[float, float]]) -> Tuple[Tuple[float, float], ...]:
-    """The convex hull of plan points, counter-clockwise (Andrew's monotone chain; a point on an edge is
-    no corner); a box of two points for a diagonal's ends (an element whose footprint is a line)."""
-    pts = sorted(set((float(x), float(y)) for x, y in points))
-    if len(pts) == 2:
-        (x0, y0), (x1, y1) = pts
-        pts = sorted({(x0, y0), (x1, y0), (x1, y1), (x0, y1)})
-    if len(pts) < 3:
-        return tuple(pts)
-
-    def cross(o, a, b) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower: list = []
-    upper: list = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return tuple(lower[:-1] + upper[:-1])
 
 
 # --- drift -----------------------------------------------------------------------------------
@@ -280,7 +256,7 @@ def lateral_drift(track: Track, heading: float) -> Drift:
     normal, the displacement d of the body origin from its start splits into distance = d . u along
     the line and total = d . n across it (positive to the left); per_m = total / distance. A track
     that runs straight at an angle a off the heading has d = s (cos(heading + a), sin(heading + a)),
-    so d . u = s cos a, d . n = s sin a and per_m = tan a. ValueError when the robot did not advance
+    so d . u = s cos a, d . n = s sin a and per_m = tan a. MetricError when the robot did not advance
     along the heading."""
     ux, uy = math.cos(heading), math.sin(heading)
     dx, dy = track.x - track.x[0], track.y - track.y[0]
@@ -288,7 +264,7 @@ def lateral_drift(track: Track, heading: float) -> Drift:
     across = -dx * uy + dy * ux
     distance, total = float(along[-1]), float(across[-1])
     if distance <= 0.0:
-        raise ValueError(
+        raise MetricError(
             f"lateral_drift: the robot advanced {distance:.3f} m along the heading {heading:.3f} rad; drift needs > 0"
         )
     worst = int(np.argmax(np.abs(across)))
@@ -377,9 +353,9 @@ def plants_touched(
     pts = np.asarray(plants, dtype=float).reshape(-1, 2)
     rects = np.asarray(footprints, dtype=float).reshape(-1, 4)
     if plant_radius < 0.0:
-        raise ValueError(f"plants_touched: plant_radius {plant_radius} m; must be >= 0")
+        raise MetricError(f"plants_touched: plant_radius {plant_radius} m; must be >= 0")
     if rects.size and np.any(rects[:, 2:] <= 0.0):
-        raise ValueError("plants_touched: a footprint's length and width must be > 0")
+        raise MetricError("plants_touched: a footprint's length and width must be > 0")
     if pts.shape[0] == 0 or rects.shape[0] == 0:
         return PlantsTouched(0, ())
     half = rects[:, 2:] / 2.0

@@ -1,6 +1,7 @@
-"""Searching a candidate's design space instead of sweeping it: a study file's ``optimise:`` section,
-a multi-objective search over the candidate's sweep that runs a few of its combinations, chosen from
-the results of those already run, where a sweep runs every one.
+"""Searching a candidate's design space instead of sweeping it: a multi-objective search over the
+candidate's sweep that runs a few of its combinations, chosen from the results of those already run,
+where a sweep runs every one. The study file's ``optimise:`` section that asks for it is read and
+checked in :mod:`thorvald_design.optimise_spec`.
 
 A sweep of k values of each of n key paths is k^n candidates, each through every scenario; past a few
 key paths that is more runs than a day holds (the study refuses more than ``MAX_CANDIDATES``). A
@@ -14,9 +15,9 @@ fails::
       trials: 20
 
 The candidate's sweep gives each key path's values: a list is the choices (categorical, as the sweep
-would run them); ``{min: 0.5, max: 1.0}`` (:func:`parse_range`) is a continuous range, which only a
-search can take. A requirement is ``">= NUMBER"``, ``"<= NUMBER"``, ``"> NUMBER"`` or ``"< NUMBER"``,
-quoted: YAML reads a bare ``>`` as the start of a folded block.
+would run them); ``{min: 0.5, max: 1.0}`` (:func:`thorvald_design.optimise_spec.parse_range`) is a
+continuous range, which only a search can take. A requirement is ``">= NUMBER"``, ``"<= NUMBER"``,
+``"> NUMBER"`` or ``"< NUMBER"``, quoted: YAML reads a bare ``>`` as the start of a folded block.
 
 ``trials`` counts combinations run: the sampler may propose one already tried, which is told its
 earlier results again at no runs (runs are deterministic: the study's seed fixes sensor noise and
@@ -45,203 +46,21 @@ saved; the requirements' scenarios are best first in the order the search is giv
 
 Pure but for the runs: ``evaluate`` runs them (the simulator, in the study). optuna is imported on
 first use (0.1 s after numpy, 0.2 s alone: SQLAlchemy and alembic come with it), so reading a study
-file does not pay for it, nor a study without ``optimise:`` need it installed.
+file does not pay for it, nor a study without ``optimise:`` need it installed. What this module
+refuses is a :class:`~thorvald_design.errors.SearchError`.
 """
 
 import itertools
 import math
-import operator
-import re
 import warnings
 from dataclasses import dataclass
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
-from thorvald_model.errors import MISSING, Problem
-from thorvald_model.schema import Key, parse_entry, short, unknown_key_rule
-
+from .errors import SearchError
+from .optimise_spec import DIRECTIONS, OptimiseSpec, Range
 from .scenarios import SCENARIOS
 
-MAX_TRIALS = 1000  # [combinations] at most a few scenarios each: a week of runs on one machine
-DEFAULT_TRIALS = 20
 MAX_ASKS = 10  # [proposals a trial] the sampler may propose combinations already tried: so many in all at most
-DIRECTIONS = {"max": "maximize", "min": "minimize"}
-OPERATORS = {">=": operator.ge, "<=": operator.le, ">": operator.gt, "<": operator.lt}
-REQUIREMENT_RULE = "must be '>= NUMBER', '<= NUMBER', '> NUMBER' or '< NUMBER' (quoted: YAML reads a bare > as a block)"
-_REQUIREMENT = re.compile(r"^\s*(>=|<=|>|<)\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*$")
-
-KEYS = (
-    Key("candidate", str),
-    Key("trials", int, DEFAULT_TRIALS, check=lambda v: 1 <= v <= MAX_TRIALS, rule=f"must be in [1, {MAX_TRIALS}]"),
-)
-KNOWN = ("candidate", "objectives", "requirements", "trials")
-RANGE_KEYS = (Key("min", float), Key("max", float))
-
-
-# ---- the study file's section -----------------------------------------------------------------------
-@dataclass(frozen=True)
-class Range:
-    """A key path's continuous range [min, max] (the sweep's ``{min: ..., max: ...}``)."""
-
-    min: float
-    max: float
-
-
-@dataclass(frozen=True)
-class Requirement:
-    """A hard requirement on a metric: ``metric op bound``, e.g. gradeability.max_climb_deg >= 15."""
-
-    metric: str  # SCENARIO.METRIC
-    op: str  # ">=", "<=", ">" or "<"
-    bound: float
-
-    def met(self, value: Any) -> bool:
-        """Whether a metric's value meets it; a value that is not a finite number never does."""
-        return _number(value) and OPERATORS[self.op](value, self.bound)
-
-    def __str__(self) -> str:
-        return f"{self.metric} {self.op} {self.bound:g}"
-
-
-@dataclass(frozen=True)
-class OptimiseSpec:
-    """A study file's ``optimise:`` section, checked."""
-
-    candidate: str  # the candidate whose sweep is the search space
-    objectives: Tuple[Tuple[str, str], ...]  # (SCENARIO.METRIC, "max" or "min"), in file order
-    requirements: Tuple[Requirement, ...] = ()
-    trials: int = DEFAULT_TRIALS  # combinations to run (different ones)
-
-    @property
-    def metrics(self) -> Tuple[str, ...]:
-        """Every metric the search reads: the objectives', then the requirements' not among them."""
-        names = [m for m, _ in self.objectives]
-        return tuple(names + [r.metric for r in self.requirements if r.metric not in names])
-
-
-def parse_optimise(
-    raw: Any,
-    path: str,
-    problems: List[Problem],
-    *,
-    candidates: Optional[Mapping[str, Any]] = None,
-    scenarios: Optional[Sequence[str]] = None,
-) -> Optional[OptimiseSpec]:
-    """The ``optimise:`` section (``raw``, ``MISSING`` or None when the file has none: None), checked:
-    a :class:`Problem` (key path, value, rule) appended to ``problems`` for each broken rule; None if
-    any of the section's own.
-
-    candidates: the study file's ``candidates`` section as read; when given, the named candidate must
-    be one of them and have a sweep. scenarios: the study's scenario names; when given, every metric
-    must be of one of them. Without either, the metrics are checked against the registry only.
-    """
-    if raw is MISSING or raw is None:
-        return None
-    found = len(problems)
-    if not isinstance(raw, Mapping):
-        problems.append(Problem(path, short(raw), "must be a mapping: candidate, objectives, requirements, trials"))
-        return None
-    for key in raw:
-        if key not in KNOWN:
-            problems.append(Problem(f"{path}.{key}", short(raw[key]), unknown_key_rule(key, KNOWN)))
-    plain = {k: v for k, v in raw.items() if k in ("candidate", "trials")}
-    values = parse_entry(plain, path, KEYS, problems)
-    if values is not None and isinstance(candidates, Mapping):
-        _check_candidate(values["candidate"], candidates, f"{path}.candidate", problems)
-    objectives = _objectives(raw.get("objectives", MISSING), f"{path}.objectives", scenarios, problems)
-    requirements = _requirements(raw.get("requirements", MISSING), f"{path}.requirements", scenarios, problems)
-    if values is None or len(problems) > found:
-        return None
-    return OptimiseSpec(values["candidate"], objectives, requirements, values["trials"])
-
-
-def parse_range(raw: Any, path: str, problems: List[Problem]) -> Optional[Range]:
-    """A sweep's ``{min: NUMBER, max: NUMBER}`` (min < max) at key path ``path``; None (problems
-    appended) if it is not one."""
-    if not isinstance(raw, Mapping):
-        problems.append(Problem(path, short(raw), "must be a list of values or a range {min: NUMBER, max: NUMBER}"))
-        return None
-    values = parse_entry(raw, path, RANGE_KEYS, problems)
-    if values is None:
-        return None
-    if not values["min"] < values["max"]:
-        problems.append(Problem(f"{path}.max", raw.get("max"), f"must be > min ({values['min']:g})"))
-        return None
-    return Range(values["min"], values["max"])
-
-
-def _check_candidate(name: str, candidates: Mapping[str, Any], path: str, problems: List[Problem]) -> None:
-    if name not in candidates:
-        known = [str(k) for k in candidates]
-        close = _close(name, known)
-        hint = f"did you mean '{close}'?" if close else "the study's candidates: " + ", ".join(known)
-        problems.append(Problem(path, name, f"no candidate of that name ({hint})"))
-        return
-    entry = candidates[name]
-    if not isinstance(entry, Mapping) or not entry.get("sweep"):
-        rule = "the candidate has no sweep: its sweep's lists (or {min, max} ranges) are the search space"
-        problems.append(Problem(path, name, rule))
-
-
-def _objectives(
-    raw: Any, path: str, scenarios: Optional[Sequence[str]], problems: List[Problem]
-) -> Tuple[Tuple[str, str], ...]:
-    if raw is MISSING:
-        problems.append(Problem(path, MISSING, "is required: 2 or 3 of SCENARIO.METRIC: max or min"))
-        return ()
-    if not isinstance(raw, Mapping) or not 2 <= len(raw) <= 3:
-        problems.append(Problem(path, short(raw), "must be a mapping of 2 or 3 of SCENARIO.METRIC: max or min"))
-        return ()
-    out = []
-    for metric, direction in raw.items():
-        where = f"{path}.{metric}"
-        if not _metric_ok(metric, direction, where, scenarios, problems):
-            continue
-        if direction not in DIRECTIONS:
-            problems.append(Problem(where, short(direction), "must be max or min"))
-            continue
-        out.append((str(metric), direction))
-    return tuple(out)
-
-
-def _requirements(
-    raw: Any, path: str, scenarios: Optional[Sequence[str]], problems: List[Problem]
-) -> Tuple[Requirement, ...]:
-    if raw is MISSING or raw is None:
-        return ()
-    if not isinstance(raw, Mapping):
-        problems.append(Problem(path, short(raw), "must be a mapping of SCENARIO.METRIC: '>= NUMBER' (or <=, >, <)"))
-        return ()
-    out = []
-    for metric, text in raw.items():
-        where = f"{path}.{metric}"
-        if not _metric_ok(metric, text, where, scenarios, problems):
-            continue
-        m = _REQUIREMENT.match(text) if isinstance(text, str) else None
-        if m is None:
-            problems.append(Problem(where, short(text), REQUIREMENT_RULE))
-            continue
-        out.append(Requirement(str(metric), m.group(1), float(m.group(2))))
-    return tuple(out)
-
-
-def _metric_ok(metric: Any, value: Any, path: str, scenarios: Optional[Sequence[str]], problems: List[Problem]) -> bool:
-    columns = [f"{name}.{result}" for name, kind in SCENARIOS.items() for result in kind.results]
-    if metric not in columns:
-        problems.append(Problem(path, short(value), unknown_key_rule(metric, columns)))
-        return False
-    scenario = str(metric).split(".")[0]
-    if scenarios is not None and scenario not in scenarios:
-        rule = f"the study has no scenario {scenario!r} (its scenarios: {', '.join(scenarios) or 'none'})"
-        problems.append(Problem(path, short(value), rule))
-        return False
-    return True
-
-
-def _close(name: str, known: Sequence[str]) -> Optional[str]:
-    import difflib  # noqa: PLC0415 (a message's only)
-
-    close = difflib.get_close_matches(name, sorted(known), n=1, cutoff=0.6)
-    return close[0] if close else None
 
 
 # ---- the search ---------------------------------------------------------------------------------------
@@ -311,14 +130,14 @@ def optimise(
     for a run that failed whole (as :func:`thorvald_design.runs.run_one`'s ``result``). After each
     scenario the requirements and objectives of its metrics are checked, and the trial is pruned at
     the first that fails: its later scenarios are not run. The front is ``study.best_trials``, one
-    trial a combination. ValueError for a space or scenario order the spec does not fit (a metric of
+    trial a combination. SearchError for a space or scenario order the spec does not fit (a metric of
     a scenario not in the order, an empty space)."""
     optuna = _optuna()
     distributions = _distributions(space, optuna)
     scenarios = list(scenario_order)
     for metric in spec.metrics:
         if metric.split(".")[0] not in scenarios:
-            raise ValueError(f"optimise: {metric} is of no scenario in the order {scenarios}")
+            raise SearchError(f"optimise: {metric} is of no scenario in the order {scenarios}")
     study = optuna.create_study(directions=[DIRECTIONS[d] for _, d in spec.objectives], sampler=_sampler(seed))
     size = _grid_size(space)
     wanted = spec.trials if size is None else min(spec.trials, size)
@@ -372,11 +191,11 @@ def _named(result: Union[Metrics, str], scenario: str, spec: OptimiseSpec) -> Di
         wanted = [m.split(".", 1)[1] for m in spec.metrics if m.split(".")[0] == scenario]
         return {f"{scenario}.{name}": result for name in list(names) + [w for w in wanted if w not in names]}
     if not isinstance(result, Mapping):
-        raise TypeError(f"optimise: evaluate gave {type(result).__name__} for {scenario}: a mapping or a string")
+        raise SearchError(f"optimise: evaluate gave {type(result).__name__} for {scenario}: a mapping or a string")
     named = {f"{scenario}.{name}": value for name, value in result.items()}
     for metric in spec.metrics:
         if metric.split(".")[0] == scenario and metric not in named:
-            raise ValueError(f"optimise: evaluate gave no {metric.split('.', 1)[1]} for {scenario}: {sorted(result)}")
+            raise SearchError(f"optimise: evaluate gave no {metric.split('.', 1)[1]} for {scenario}: {sorted(result)}")
     return named
 
 
@@ -403,19 +222,19 @@ def _grid_size(space: Space) -> Optional[int]:
 
 def _distributions(space: Space, optuna: Any) -> Dict[str, Any]:
     if not space:
-        raise ValueError("optimise: the space is empty (the candidate's sweep names no key path)")
+        raise SearchError("optimise: the space is empty (the candidate's sweep names no key path)")
     out = {}
     for key_path, dimension in space:
         if key_path in out:
-            raise ValueError(f"optimise: {key_path} is twice in the space")
+            raise SearchError(f"optimise: {key_path} is twice in the space")
         if isinstance(dimension, Range):
             if not dimension.min < dimension.max:
-                raise ValueError(f"optimise: {key_path}: the range's min must be < its max")
+                raise SearchError(f"optimise: {key_path}: the range's min must be < its max")
             out[key_path] = optuna.distributions.FloatDistribution(dimension.min, dimension.max)
         else:
             choices = tuple(float(v) for v in dimension)
             if not choices or len(set(choices)) != len(choices):
-                raise ValueError(f"optimise: {key_path}: the choices must be values that differ, at least one")
+                raise SearchError(f"optimise: {key_path}: the choices must be values that differ, at least one")
             out[key_path] = optuna.distributions.CategoricalDistribution(choices)
     return out
 
@@ -447,11 +266,11 @@ class SweepFront:
 
 
 def grid(space: Space) -> List[Dict[str, float]]:
-    """Every combination of a space of choices (key path -> value), in a sweep's order; ValueError
+    """Every combination of a space of choices (key path -> value), in a sweep's order; SearchError
     for a range (no sweep runs one)."""
     for key_path, dimension in space:
         if isinstance(dimension, Range):
-            raise ValueError(f"optimise: {key_path} is a range: no sweep runs every value of it")
+            raise SearchError(f"optimise: {key_path} is a range: no sweep runs every value of it")
     keys = [key_path for key_path, _ in space]
     return [dict(zip(keys, (float(v) for v in combo))) for combo in itertools.product(*(d for _, d in space))]
 
@@ -503,17 +322,17 @@ def pareto_front(points: Sequence[Sequence[float]], directions: Sequence[int]) -
 
     directions: per coordinate, +1 if larger is better, -1 if smaller is. A point dominates another
     when it is at least as good in every coordinate and better in one; equal points dominate neither,
-    so both are on the front. ValueError for a direction not +-1, a point of another length than the
+    so both are on the front. SearchError for a direction not +-1, a point of another length than the
     directions, or a coordinate that is not a finite number.
     """
     if any(d not in (1, -1) for d in directions):
-        raise ValueError(f"directions must be +1 or -1, not {list(directions)}")
+        raise SearchError(f"directions must be +1 or -1, not {list(directions)}")
     scored = []
     for i, point in enumerate(points):
         if len(point) != len(directions):
-            raise ValueError(f"point {i} has {len(point)} coordinates, the directions {len(directions)}")
+            raise SearchError(f"point {i} has {len(point)} coordinates, the directions {len(directions)}")
         if not all(_finite(v) for v in point):
-            raise ValueError(f"point {i} is not finite numbers: {list(point)}")
+            raise SearchError(f"point {i} is not finite numbers: {list(point)}")
         scored.append(tuple(d * float(v) for d, v in zip(directions, point)))
     return [i for i, p in enumerate(scored) if not any(_better(q, p) for q in scored)]
 
@@ -543,7 +362,7 @@ def compare(optimised: OptimiseResult, full: SweepFront) -> Dict[str, Any]:
     no front); and how many of the search's front points the sweep's front dominates (combinations
     the search took for the front for want of a better one)."""
     if optimised.objectives != full.objectives:
-        raise ValueError("compare: the search and the sweep have different objectives")
+        raise SearchError("compare: the search and the sweep have different objectives")
     directions = _signs(full.objectives)
     names = [m for m, _ in full.objectives]
     found_points = [optimised.trials[n] for n in optimised.front]
@@ -587,9 +406,6 @@ def compare(optimised: OptimiseResult, full: SweepFront) -> Dict[str, Any]:
 
 __all__ = [
     "OptimiseResult",
-    "OptimiseSpec",
-    "Range",
-    "Requirement",
     "SweepFront",
     "Trial",
     "compare",
@@ -598,7 +414,5 @@ __all__ = [
     "grid",
     "optimise",
     "pareto_front",
-    "parse_optimise",
-    "parse_range",
     "sweep_front",
 ]

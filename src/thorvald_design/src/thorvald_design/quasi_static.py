@@ -1,8 +1,9 @@
 """The quasi-static limits of a wheeled robot: how steep it climbs, how hard it pulls, how close it is
 to tipping, from its weight, centre of mass, wheel contacts, surface friction and motor torques.
 
-Pure: numbers in, numbers out (stdlib, numpy and thorvald_model only; no rospy, no pybullet, no
-messages). A design study predicts with it, and checks a simulation's results against it.
+Pure: numbers in, numbers out (stdlib and numpy only; no rospy, no pybullet, no messages). A design
+study predicts with it, and checks a simulation's results against it. A robot's layout is read from
+its configuration and description apart, in :mod:`thorvald_design.robot_layout`.
 
 Frames and signs. Everything is in base_link's axes (x forward, y left), SI units, angles in radians
 (the results' ``to_dict`` gives degrees). The robot stands on a plane; z is the height above that
@@ -81,24 +82,21 @@ other model, of a wheel sinking into soft soil; the simulator's wheels roll on s
 rolling resistance as a torque, and a simulated pull agrees with this one (mud: mu W, not
 (mu - C_rr) W).
 
-Casters: :func:`layout_of` puts a caster's contact at its swivel axis (x, y). The wheel really
-trails the axis by caster_offset, behind it when the robot drives forward, so the real support
-polygon is that much larger (at most caster_offset, 5 cm on the example robots) in the direction of
-travel: the figures here are slightly conservative for a robot standing on casters.
+Casters: :func:`thorvald_design.robot_layout.layout_of` puts a caster's contact at its swivel axis
+(x, y). The wheel really trails the axis by caster_offset, behind it when the robot drives forward,
+so the real support polygon is that much larger (at most caster_offset, 5 cm on the example robots)
+in the direction of travel: the figures here are slightly conservative for a robot standing on
+casters.
 """
 
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Callable, Collection, Dict, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from thorvald_model import load_robot_config
-from thorvald_model.description import generate_urdf
-from thorvald_model.joint_tree import JointTree
-from thorvald_model.mass_properties import link_poses, mass_properties
-from thorvald_model.values import RobotConfig
+from .errors import StaticsError
+from .geometry import hull_corners
 
 __all__ = [
     "TIPPING",
@@ -112,8 +110,6 @@ __all__ = [
     "PullLimit",
     "contact_loads",
     "gradeability",
-    "layout_of",
-    "load_layout",
     "max_pull",
     "normal_loads",
     "overturning_angles",
@@ -125,7 +121,6 @@ GRAVITY = 9.81  # [m/s^2]
 ANGLE_TOLERANCE = 1e-6  # [rad] the limits' bisection stops within it
 FORCE_TOLERANCE = 1e-6  # [N]
 COLLINEAR_TOLERANCE = 1e-6  # [m] contacts nearer than this to one line stand on a line
-GROUND_TOLERANCE = 0.01  # [m] the wheels' lowest points may differ this much and still stand on one plane
 _SCAN_STEPS = 256  # a limit is first bracketed on this many steps, so that it is the first crossing
 
 # What binds a limit
@@ -147,9 +142,9 @@ class Contact:
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.x) and math.isfinite(self.y)):
-            raise ValueError(f"contact {self.name}: position ({self.x}, {self.y}) is not finite")
+            raise StaticsError(f"contact {self.name}: position ({self.x}, {self.y}) is not finite")
         if not (self.max_force >= 0.0 and math.isfinite(self.max_force)):
-            raise ValueError(f"contact {self.name}: max_force {self.max_force} N must be finite and >= 0")
+            raise StaticsError(f"contact {self.name}: max_force {self.max_force} N must be finite and >= 0")
 
 
 @dataclass(frozen=True)
@@ -157,7 +152,7 @@ class Layout:
     """A robot as its quasi-static limits see it: its mass, its centre of mass and its wheel contacts.
 
     com: x, y in base_link; z is the height above the ground plane [m]. A layout has at least three
-    contacts not on one line (the least a robot stands on); ValueError otherwise.
+    contacts not on one line (the least a robot stands on); StaticsError otherwise.
     """
 
     mass: float  # [kg]
@@ -168,25 +163,25 @@ class Layout:
         object.__setattr__(self, "contacts", tuple(self.contacts))
         object.__setattr__(self, "com", tuple(float(v) for v in self.com))
         if not (self.mass > 0.0 and math.isfinite(self.mass)):
-            raise ValueError(f"the robot's mass must be finite and > 0 kg, not {self.mass}")
+            raise StaticsError(f"the robot's mass must be finite and > 0 kg, not {self.mass}")
         if len(self.com) != 3 or not all(math.isfinite(v) for v in self.com):
-            raise ValueError(f"the centre of mass must be 3 finite numbers (x, y, height), not {self.com}")
+            raise StaticsError(f"the centre of mass must be 3 finite numbers (x, y, height), not {self.com}")
         if self.com[2] < 0.0:
-            raise ValueError(f"the centre of mass is {-self.com[2]:.3f} m below the ground: its height must be >= 0")
+            raise StaticsError(f"the centre of mass is {-self.com[2]:.3f} m below the ground: its height must be >= 0")
         names = [c.name for c in self.contacts]
         if len(self.contacts) < 3:
-            raise ValueError(
+            raise StaticsError(
                 f"a robot needs at least 3 wheel contacts not on one line to stand; this layout has "
                 f"{len(self.contacts)} ({', '.join(names) or 'none'})"
             )
         if len(set(names)) != len(names):
-            raise ValueError(f"the contacts' names repeat: {', '.join(names)}")
+            raise StaticsError(f"the contacts' names repeat: {', '.join(names)}")
         # The contacts' RMS distance from their best-fitting line: the smaller singular value of their
         # centred positions over sqrt(n).
         xy = np.array([(c.x, c.y) for c in self.contacts])
         spread = np.linalg.svd(xy - xy.mean(axis=0), compute_uv=False)[-1] / math.sqrt(len(xy))
         if spread < COLLINEAR_TOLERANCE:
-            raise ValueError(
+            raise StaticsError(
                 f"the wheel contacts {', '.join(names)} lie on one line: a robot needs 3 contacts not on "
                 "one line to stand"
             )
@@ -208,86 +203,20 @@ class Layout:
 def with_payload(layout: Layout, mass: float, x: float, y: float, z_above_ground: float) -> Layout:
     """The layout carrying a point mass [kg] at (x, y) in base_link, z_above_ground above the ground."""
     if not (mass >= 0.0 and math.isfinite(mass)):
-        raise ValueError(f"the payload's mass must be finite and >= 0 kg, not {mass}")
+        raise StaticsError(f"the payload's mass must be finite and >= 0 kg, not {mass}")
     if not all(math.isfinite(v) for v in (x, y, z_above_ground)):
-        raise ValueError(f"the payload's position ({x}, {y}, {z_above_ground}) is not finite")
+        raise StaticsError(f"the payload's position ({x}, {y}, {z_above_ground}) is not finite")
     total = layout.mass + mass
     com = tuple((layout.mass * c + mass * p) / total for c, p in zip(layout.com, (x, y, z_above_ground)))
     return Layout(total, com, layout.contacts)  # type: ignore[arg-type]
 
 
-def layout_of(
-    config: RobotConfig, urdf_xml: str, driven: Optional[Collection[str]] = None, tf_prefix: str = ""
-) -> Layout:
-    """The layout of a robot: its configuration's wheel contacts, its description's mass and centre of mass.
-
-    driven: the names of the drives that drive (default: every drive); passive wheels never do. A
-    drive's contact is under its steering axis, (x, y); a fixed passive wheel's at its (x, y); a
-    caster's at its swivel axis (x, y) (see the module's docstring). The ground plane is found from
-    the description: each wheel's centre (its link's origin, every joint at 0: wheels straight,
-    suspensions at rest) less its radius; the centre of mass's height is measured from it. The
-    description is the one generated from the configuration (``generate_urdf(robot_file,
-    tf_prefix)``); ValueError if a wheel joint is missing from it, the wheels' lowest points do not
-    lie on one plane, or driven names a drive the robot does not have.
-    """
-    names = {d.name for d in config.drives}
-    driven_names = set(names if driven is None else driven)
-    unknown = sorted(driven_names - names)
-    if unknown:
-        raise ValueError(f"driven names {', '.join(unknown)}: the robot's drives are {', '.join(sorted(names))}")
-
-    props = mass_properties(urdf_xml)
-    tree = JointTree(urdf_xml)
-    _, poses = link_poses(tree, [link.get("name", "") for link in ET.fromstring(urdf_xml).findall("link")])
-
-    def lowest_point(joint: str, radius: float) -> float:
-        if joint not in tree.joints:
-            raise ValueError(f"the robot description has no wheel joint {joint!r}")
-        child = tree.joints[joint][0]
-        return poses[child][0][2] - radius  # the wheel link's origin is the wheel's centre
-
-    contacts: List[Contact] = []
-    grounds: Dict[str, float] = {}
-    for d in config.drives:
-        joint = tf_prefix + (d.wheel_name or f"wheel{d.index}")
-        grounds[d.name] = lowest_point(joint, d.r_wheel)
-        is_driven = d.name in driven_names
-        contacts.append(Contact(d.name, d.x, d.y, is_driven, d.max_wheel_torque / d.r_wheel if is_driven else 0.0))
-    for w in config.passive_wheels:
-        grounds[w.name] = lowest_point(f"{tf_prefix}{w.name}_wheel", w.r_wheel)
-        contacts.append(Contact(w.name, w.x, w.y, False, 0.0))
-    ground = sum(grounds.values()) / len(grounds) if grounds else 0.0
-    if grounds and max(grounds.values()) - min(grounds.values()) > GROUND_TOLERANCE:
-        heights = ", ".join(f"{k} {v:+.3f}" for k, v in grounds.items())
-        raise ValueError(f"the wheels do not stand on one plane: their lowest points are at z = {heights} m")
-    return Layout(props.mass, (props.com[0], props.com[1], props.com[2] - ground), tuple(contacts))
-
-
-def load_layout(robot_file: str, driven: Optional[Collection[str]] = None) -> Layout:
-    """:func:`layout_of` a robot configuration file and the description generated from it."""
-    return layout_of(load_robot_config(robot_file), generate_urdf(robot_file), driven)
-
-
 # ---- the support polygon ---------------------------------------------------------------------------
-def _cross(o: Tuple[float, float], a: Tuple[float, float], b: Tuple[float, float]) -> float:
-    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-
 def support_polygon(layout: Layout) -> Tuple[Contact, ...]:
     """The support polygon's corners: the convex hull of the contacts in plan, anticlockwise seen from
-    above (Andrew's monotone chain); a contact on an edge (a 6WD's middle wheel) is no corner."""
-    points = sorted(layout.contacts, key=lambda c: (c.x, c.y))
-
-    def half(chain: Sequence[Contact]) -> List[Contact]:
-        out: List[Contact] = []
-        for c in chain:
-            while len(out) >= 2 and _cross((out[-2].x, out[-2].y), (out[-1].x, out[-1].y), (c.x, c.y)) <= 0.0:
-                out.pop()
-            out.append(c)
-        return out
-
-    lower, upper = half(points), half(points[::-1])
-    return tuple(lower[:-1] + upper[:-1])
+    above (:func:`thorvald_design.geometry.hull_corners`); a contact on an edge (a 6WD's middle wheel)
+    is no corner."""
+    return tuple(layout.contacts[i] for i in hull_corners([(c.x, c.y) for c in layout.contacts]))
 
 
 def _edges(layout: Layout) -> List[Tuple[Contact, Contact, float, float]]:
@@ -319,7 +248,7 @@ def _distance_to_edge(layout: Layout, px: float, py: float, ux: float, uy: float
 
 def _check_stands(layout: Layout) -> None:
     if min(_inside_distances(layout, layout.com[0], layout.com[1])) <= 0.0:
-        raise ValueError(
+        raise StaticsError(
             f"the centre of mass ({layout.com[0]:.3f}, {layout.com[1]:.3f}) is not inside the support polygon "
             f"({', '.join(c.name for c in support_polygon(layout))}): the robot falls over on level ground"
         )
@@ -353,13 +282,13 @@ def _resultants(
     docstring), sum N x is rolling_offset Nz less."""
     for what, v in (("pitch", pitch), ("roll", roll)):
         if not (abs(v) <= math.pi / 2):
-            raise ValueError(f"{what} {v} rad is not within +-pi/2")
+            raise StaticsError(f"{what} {v} rad is not within +-pi/2")
     if not (gravity > 0.0 and math.isfinite(gravity)):
-        raise ValueError(f"gravity must be finite and > 0, not {gravity}")
+        raise StaticsError(f"gravity must be finite and > 0, not {gravity}")
     if not (math.isfinite(pull) and math.isfinite(pull_height)):
-        raise ValueError(f"the pull {pull} N at {pull_height} m is not finite")
+        raise StaticsError(f"the pull {pull} N at {pull_height} m is not finite")
     if not (rolling_offset >= 0.0 and math.isfinite(rolling_offset)):
-        raise ValueError(f"rolling_offset must be finite and >= 0 m, not {rolling_offset}")
+        raise StaticsError(f"rolling_offset must be finite and >= 0 m, not {rolling_offset}")
     w = layout.mass * gravity
     xc, yc, h = layout.com
     nz = w * math.cos(pitch) * math.cos(roll)
@@ -430,7 +359,7 @@ def _one_sided(rows: np.ndarray, f: np.ndarray) -> np.ndarray:
         while phi(k + t * step) > phi0 + 1e-4 * t * slope and t > 1e-12:
             t *= 0.5
         k = k + t * step
-    raise RuntimeError(f"the wheel loads did not converge (resultants {f.tolist()})")
+    raise StaticsError(f"the wheel loads did not converge (resultants {f.tolist()})")
 
 
 def contact_loads(
@@ -446,7 +375,7 @@ def contact_loads(
     """Each contact's normal load [N] as the wheels carry it: all >= 0, a lifted wheel's 0.
 
     The same rigid frame on wheel springs as :func:`normal_loads`, the springs one-sided; equal to
-    normal_loads while it has no load below 0. ValueError if the robot tips: the centre of pressure is
+    normal_loads while it has no load below 0. StaticsError if the robot tips: the centre of pressure is
     not inside the support polygon, so no loads >= 0 balance it.
     """
     nz, my, mx = _resultants(
@@ -454,7 +383,7 @@ def contact_loads(
     )
     if nz <= 0.0 or min(_inside_distances(layout, my / nz, mx / nz)) <= 0.0:
         where = f"({my / nz:.3f}, {mx / nz:.3f})" if nz > 0.0 else "at infinity"
-        raise ValueError(
+        raise StaticsError(
             f"the robot tips at pitch {math.degrees(pitch):.2f} deg, roll {math.degrees(roll):.2f} deg, pull "
             f"{pull:.1f} N: its centre of pressure {where} is outside the support polygon"
         )
@@ -492,16 +421,16 @@ def _first_failure(holds: Callable[[float], bool], upper: float, tolerance: floa
 
 def _check_surface(friction: float, rolling_resistance: float, gravity: float) -> None:
     if not (friction >= 0.0 and math.isfinite(friction)):
-        raise ValueError(f"friction (mu) must be finite and >= 0, not {friction}")
+        raise StaticsError(f"friction (mu) must be finite and >= 0, not {friction}")
     if not (rolling_resistance >= 0.0 and math.isfinite(rolling_resistance)):
-        raise ValueError(f"rolling_resistance (C_rr) must be finite and >= 0, not {rolling_resistance}")
+        raise StaticsError(f"rolling_resistance (C_rr) must be finite and >= 0, not {rolling_resistance}")
     if not (gravity > 0.0 and math.isfinite(gravity)):
-        raise ValueError(f"gravity must be finite and > 0, not {gravity}")
+        raise StaticsError(f"gravity must be finite and > 0, not {gravity}")
 
 
 def _check_driven(layout: Layout) -> None:
     if not layout.driven:
-        raise ValueError(f"no wheel of the layout is driven ({', '.join(c.name for c in layout.contacts)})")
+        raise StaticsError(f"no wheel of the layout is driven ({', '.join(c.name for c in layout.contacts)})")
 
 
 def _driving(friction: float, rolling_resistance: float) -> float:
@@ -600,7 +529,7 @@ def gradeability(
     rolling_offset: float = 0.0,
 ) -> GradeLimits:
     """The robot's grade limits (:class:`GradeLimits`) on a surface of friction mu and rolling
-    resistance C_rr; ValueError if no wheel is driven or the robot cannot stand on level ground.
+    resistance C_rr; StaticsError if no wheel is driven or the robot cannot stand on level ground.
 
     Climbing forward at constant speed on a slope theta, the driven wheels must push up the slope
     the weight's component along it and the rolling resistance of every wheel (the statics: the
@@ -712,13 +641,13 @@ def max_pull(
     distance from the centre of mass back to the support polygon's edge. sum min(...) is at most
     min((mu + C_rr) W, sum F_i), so the pull is too; the first failing pull is bracketed and bisected to 1e-6 N.
     rolling_offset [m]: as :func:`gradeability`'s (the centre of pressure that much further back).
-    ValueError if no wheel is driven, the robot cannot stand or pull_height < 0.
+    StaticsError if no wheel is driven, the robot cannot stand or pull_height < 0.
     """
     _check_surface(friction, rolling_resistance, gravity)
     _check_driven(layout)
     _check_stands(layout)
     if not (pull_height >= 0.0 and math.isfinite(pull_height)):
-        raise ValueError(f"pull_height must be finite and >= 0 m, not {pull_height}")
+        raise StaticsError(f"pull_height must be finite and >= 0 m, not {pull_height}")
     w = layout.weight(gravity)
     e = rolling_offset
     back = max(_distance_to_edge(layout, layout.com[0] - e, layout.com[1], -1.0, 0.0), 0.0)

@@ -68,8 +68,9 @@ from thorvald_model.schema import (
     unknown_key_rule,
 )
 
-from .optimise import Range, parse_optimise, parse_range
-from .scenarios import SCENARIOS
+from .errors import StudyError
+from .optimise_spec import Range, parse_optimise, parse_range
+from .scenarios import SCENARIOS, declared
 
 WHAT = "design study"
 MAX_CANDIDATES = 256  # after sweeps: more runs than a study on one machine finishes in a day
@@ -178,17 +179,19 @@ class Space:
     robot_data: Mapping
     as_built: str
     payload: Optional[Payload]
-    dimensions: Tuple[Tuple[str, Any], ...]  # (key path, tuple of values or optimise.Range)
+    dimensions: Tuple[Tuple[str, Any], ...]  # (key path, tuple of values or optimise_spec.Range)
 
     def candidate(self, values: Mapping[str, float]) -> Candidate:
-        """The candidate of one combination (key path -> value), named as a sweep names it; ValueError
-        if the robot files' rules refuse it."""
+        """The candidate of one combination (key path -> value), named as a sweep names it; StudyError
+        if a key path names no entry of the robot file, thorvald_model's ConfigError if the robot
+        files' rules refuse the robot it makes."""
         swept = tuple((key_path, float(values[key_path])) for key_path, _ in self.dimensions)
         problems: List[Problem] = []
         robot = _applied(self.robot_data, swept, self.payload, self.name, problems)
         label = _label(self.name, swept)
         if robot is None or problems:
-            raise ValueError(f"{label}: " + "; ".join(f"{p.path}: {p.rule}" for p in problems))
+            why = "; ".join(f"{p.path}: {p.rule}" for p in problems)
+            raise StudyError(label, [Problem("", MISSING, why)], WHAT)  # one line: "LABEL: why"
         config = parse_robot_config(robot, f"{self.robot_file} ({label})")  # ConfigError: refused
         refused = calculator_problems(config)
         if refused:
@@ -204,22 +207,30 @@ class Study:
     candidates: Tuple[Candidate, ...]
     scenarios: Tuple[Tuple[str, Mapping[str, Any]], ...]  # (scenario, its checked parameters), in file order
     text: str = ""  # the study file as written (the report shows it)
-    optimise: Any = None  # thorvald_design.optimise.OptimiseSpec of an ``optimise:`` section, or None
+    optimise: Any = None  # thorvald_design.optimise_spec.OptimiseSpec of an ``optimise:`` section, or None
     pareto: Optional[Tuple[str, str]] = None  # two SCENARIO.METRIC columns the report's Pareto plot compares
     space: Optional[Space] = None  # the optimised candidate's (among ``candidates`` too, unless it has a range)
 
 
 def load_study(path: str) -> Study:
-    """Reads and checks a study file; ConfigError naming every problem (the file, key path, value, rule)."""
-    data = read_yaml_file(path, WHAT)
+    """Reads and checks a study file; StudyError (a ConfigError) naming every problem (the file, key
+    path, value, rule), or the one reason a file that cannot be read at all cannot."""
+    try:
+        data = read_yaml_file(path, WHAT)
+    except ConfigError as e:
+        raise StudyError(e.source, e.problems, e.what) from None
     with open(path, encoding="utf-8", errors="replace") as f:
         text = f.read()
     return parse_study(data, path, base_dir=os.path.dirname(os.path.abspath(path)), text=text)
 
 
 def parse_study(data: Any, source: str = "<study>", base_dir: str = ".", text: str = "") -> Study:
+    """A study file's contents (YAML read) checked; StudyError naming every problem."""
     problems: List[Problem] = []
-    data = check_top_level(data, KNOWN, problems, source=source, what=WHAT)
+    try:
+        data = check_top_level(data, KNOWN, problems, source=source, what=WHAT)
+    except ConfigError as e:  # not a mapping: the one problem of the whole file
+        raise StudyError(e.source, e.problems, e.what) from None
     description = parse_scalar(data, TOP_KEYS[0], problems)
     seed = parse_scalar(data, TOP_KEYS[1], problems)
     scenarios = _scenarios(data.get("scenarios", MISSING), problems)
@@ -236,7 +247,7 @@ def parse_study(data: Any, source: str = "<study>", base_dir: str = ".", text: s
     spaces: List[Space] = []
     candidates = _candidates(raw_candidates, base_dir, problems, searched, spaces)
     if problems:
-        raise ConfigError(source, problems, WHAT)
+        raise StudyError(source, problems, WHAT)
     space = spaces[0] if spaces else None
     return Study(
         source, description, seed, tuple(candidates), tuple(scenarios), text, optimise=spec, space=space, pareto=pareto
@@ -260,6 +271,9 @@ def _pareto(
             close = close_key(str(column), known)
             hint = f" (did you mean {close!r}?)" if close else f" (the study's: {', '.join(known)})"
             problems.append(Problem(f"pareto[{k}]", column, "is not a metric of the study's scenarios" + hint))
+        elif declared(column) is None or declared(column).words:  # refused here, not by the report after the runs
+            rule = "is a metric of words, not numbers: it has no better direction to plot a front by"
+            problems.append(Problem(f"pareto[{k}]", column, rule))
     return (str(raw[0]), str(raw[1])) if len(problems) == found else None
 
 

@@ -10,7 +10,7 @@ from types import SimpleNamespace
 import pytest
 
 from thorvald_design.design import design_of
-from thorvald_design.report import parse_tracks
+from thorvald_design.report.tracks import parse_tracks
 from thorvald_design.runs import write_tracks
 from thorvald_design.scenarios.driving import as_simulated, rolling_offset, simulated_layout
 from thorvald_design.scenarios.gradeability import _limits

@@ -1,5 +1,6 @@
-"""thorvald_design.optimise: the study file's optimise: section, and the search on a synthetic study
-whose Pareto front is known in closed form (no simulator: ``evaluate`` is arithmetic).
+"""thorvald_design.optimise_spec and thorvald_design.optimise: the study file's optimise: section, and
+the search on a synthetic study whose Pareto front is known in closed form (no simulator: ``evaluate``
+is arithmetic).
 
 The synthetic study: a track of 0.5 to 0.9 m and a wheel radius of 0.2 to 0.3 m (15 combinations);
 climb [deg] = 10 + 20 (track - 0.5) + 40 (r_wheel - 0.2), turning diameter [m] = 2 track + 1. The
@@ -19,18 +20,12 @@ from typing import Any, Dict, List, Optional, Tuple
 import pytest
 import yaml
 
-from thorvald_design.optimise import (
+from thorvald_design.optimise import OptimiseResult, Trial, compare, full_sweep, grid, optimise, pareto_front
+from thorvald_design.optimise_spec import (
     REQUIREMENT_RULE,
-    OptimiseResult,
     OptimiseSpec,
     Range,
     Requirement,
-    Trial,
-    compare,
-    full_sweep,
-    grid,
-    optimise,
-    pareto_front,
     parse_optimise,
     parse_range,
 )

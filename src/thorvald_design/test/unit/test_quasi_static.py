@@ -17,14 +17,13 @@ from thorvald_design.quasi_static import (
     Layout,
     contact_loads,
     gradeability,
-    layout_of,
-    load_layout,
     max_pull,
     normal_loads,
     overturning_angles,
     support_polygon,
     with_payload,
 )
+from thorvald_design.robot_layout import layout_of, load_layout
 from thorvald_model import load_robot_config
 from thorvald_model.description import generate_urdf
 

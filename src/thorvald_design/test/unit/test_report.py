@@ -18,22 +18,15 @@ from hypothesis import given
 from hypothesis import strategies as st
 from PIL import Image
 
+from thorvald_design.errors import ReportError, SearchError
+from thorvald_design.geometry import convex_hull, rectangle
 from thorvald_design.optimise import pareto_front
-from thorvald_design.report import (
-    DIRECTIONS,
-    TEXT_METRICS,
-    best,
-    convex_hull,
-    metrics,
-    pareto_plane,
-    parse_tracks,
-    sweeps,
-    view,
-    world_map,
-    write_report,
-)
+from thorvald_design.report import write_report
+from thorvald_design.report.plan import view, world_map
+from thorvald_design.report.table import best, metrics, pareto_plane, sweeps
+from thorvald_design.report.tracks import parse_tracks
 from thorvald_design.runs import safe_name
-from thorvald_design.scenarios import SCENARIOS
+from thorvald_design.scenarios import LARGER, SCENARIOS, SMALLER, declared
 from thorvald_design.scenarios.driving import ramp_world
 from thorvald_design.study import Candidate, Study
 from thorvald_sim.world import parse_world
@@ -74,7 +67,7 @@ def test_pareto_front_known_answers(points, directions, front):
     ],
 )
 def test_pareto_front_refuses_what_it_cannot_rank(points, directions, message):
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises(SearchError, match=message):
         pareto_front(points, directions)
 
 
@@ -107,17 +100,28 @@ def test_pareto_front_is_what_nothing_beats_and_beats_the_rest(case):
 
 # ---- what is plotted ------------------------------------------------------------------------------------
 def test_every_metric_of_every_scenario_has_a_direction_or_is_words():
+    """Each scenario declares its metrics (the report keeps no table of its own): a number has a unit
+    and a direction, a word neither; a metric of one surface of several is its metric's."""
+    directions = set()
     for kind in SCENARIOS.values():
-        for metric in kind.results:
-            assert metric in DIRECTIONS or metric in TEXT_METRICS, (kind.name, metric)
-    assert set(DIRECTIONS.values()) == {1, -1}
-    assert not set(DIRECTIONS) & set(TEXT_METRICS)
-    for name in ("max_climb_deg", "max_descent_deg", "max_traverse_deg", "static_overturning_deg", "max_pull_n",
-                 "max_step_m", "range_km"):  # fmt: skip
-        assert DIRECTIONS[name] == 1, name
-    for name in ("turning_diameter_m", "clearance_diameter_m", "drift_per_m", "min_headland_m", "plants_touched",
-                 "wh_per_km", "wh_per_ha", "peak_current_a", "odometry_error_pct"):  # fmt: skip
-        assert DIRECTIONS[name] == -1, name
+        for metric in kind.metrics:
+            assert metric.words or metric.direction in (LARGER, SMALLER), (kind.name, metric.name)
+            assert bool(metric.unit) != metric.words and metric.meaning, (kind.name, metric.name)
+            assert declared(f"{kind.name}.{metric.name}") is metric
+            directions.add(metric.direction)
+    assert directions == {1, -1, 0}
+    words = {"gradeability.surface", "gradeability.limited_by", "gradeability.predicted_limited_by",
+             "turning.turn", "headland.turn", "drawbar.limited_by", "drawbar.surface"}  # fmt: skip
+    assert {f"{k.name}.{m.name}" for k in SCENARIOS.values() for m in k.metrics if m.words} == words
+    for column in ("gradeability.max_climb_deg", "gradeability.max_descent_deg", "side_slope.max_traverse_deg",
+                   "side_slope.static_overturning_deg", "drawbar.max_pull_n", "drawbar.max_pull_n.mud",
+                   "obstacle.max_step_m", "energy.range_km"):  # fmt: skip
+        assert declared(column).direction == 1, column
+    for column in ("turning.turning_diameter_m", "turning.clearance_diameter_m", "side_slope.drift_per_m",
+                   "headland.min_headland_m", "headland.plants_touched", "energy.wh_per_km", "energy.wh_per_ha",
+                   "energy.peak_current_a", "rails.odometry_error_pct"):  # fmt: skip
+        assert declared(column).direction == -1, column
+    assert declared("gradeability.nothing") is None and declared("nothing.max_climb_deg") is None
 
 
 GRADEABILITY = {"surface": "grass", "speed": 0.5}
@@ -224,9 +228,9 @@ def test_pareto_plane_takes_the_candidates_with_both_numbers():
     assert [p[0] for p in plane.points] == ["std", "wide[y=0.6]", "wide[y=0.9]"]
     assert [plane.points[i][0] for i in plane.front] == ["std"]  # steepest climb and tightest turn
     assert [m[0] for m in plane.missing] == ["wide[y=0.75]", "broken"]
-    with pytest.raises(ValueError, match="not a column"):
+    with pytest.raises(ReportError, match="not a column"):
         pareto_plane(results, study, ("gradeability.max_climb_deg", "drawbar.max_pull_n"))
-    with pytest.raises(ValueError, match="better direction"):
+    with pytest.raises(ReportError, match="better direction"):
         pareto_plane(results, study, ("gradeability.max_climb_deg", "gradeability.limited_by"))
 
 
@@ -256,6 +260,10 @@ def test_world_map_of_a_ramp_rows_and_a_box():
 def test_convex_hull_and_the_view_of_a_spin():
     assert convex_hull([(0, 0), (1, 0), (1, 1), (0, 1), (0.5, 0.5)]) == ((0, 0), (1, 0), (1, 1), (0, 1))
     assert convex_hull([(0, 0), (2, 1)]) == ((0, 0), (2, 0), (2, 1), (0, 1))  # a box's diagonal
+    # the one rectangle: anticlockwise from (-u, -v), turned about its centre
+    turned = rectangle(1.0, 2.0, math.pi / 2, 2.0, 0.5)
+    assert corners(turned) == corners([(0.5, 0.0), (1.5, 0.0), (1.5, 4.0), (0.5, 4.0)])
+    assert rectangle(0.0, 0.0, 0.0, 2.0, 1.0) == ((-2.0, -1.0), (2.0, -1.0), (2.0, 1.0), (-2.0, 1.0))
     tracks = parse_tracks({"tracks": [{"x": [0.0, 0.01], "y": [0.0, 0.0], "yaw": [0.0, 3.0]}]})
     (x0, x1), (y0, y1) = view(tracks.drives, None)
     assert x1 - x0 >= 4.0 and y1 - y0 >= 4.0  # a spin on the spot is seen at a robot's scale
@@ -275,7 +283,7 @@ def test_parse_tracks_takes_the_files_world_and_says_what_is_wrong():
         ({"tracks": [{"x": [0, 1], "y": [0, 1], "yaw": [0]}]}, "yaw"),
         ({"tracks": ["a"]}, "not a mapping"),
     ]:
-        with pytest.raises(ValueError, match=message):
+        with pytest.raises(ReportError, match=message):
             parse_tracks(bad)
 
 
@@ -510,7 +518,7 @@ def test_write_report_of_one_scenario_without_pictures_tracks_or_pareto(tmp_path
 
 def test_write_report_refuses_a_pareto_of_no_columns_before_writing(tmp_path):
     study, results = made_study()
-    with pytest.raises(ValueError, match="not a column"):
+    with pytest.raises(ReportError, match="not a column"):
         write_report(str(tmp_path), results, study, pareto=("gradeability.max_climb_deg", "turning.nothing"))
     assert os.listdir(tmp_path) == []
 

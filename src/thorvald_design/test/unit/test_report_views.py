@@ -1,4 +1,4 @@
-"""What the report's figures carry (thorvald_design.report_views, and the plots drawn from it): a
+"""What the report's figures carry (thorvald_design.report.views, and the plots drawn from it): a
 measured limit beside its prediction and the sentence the page says only where they are more than
 the study's step apart; a turn's ISO 789-3 circles and its outermost wheel's path, a spin's included;
 the headland's turns a colour and a legend entry each, the plants they touched ringed; a series of
@@ -11,27 +11,26 @@ import matplotlib
 import numpy as np
 import pytest
 
-from thorvald_design.report import (
+from thorvald_design.report.page import turns_html
+from thorvald_design.report.plan import world_map
+from thorvald_design.report.plots import (
     GAP,
     RC,
-    Drive,
-    parse_tracks,
     plot_comparison,
     plot_headland,
     plot_side,
     plot_turning,
     side_exaggeration,
-    turns_html,
-    world_map,
 )
-from thorvald_design.report_views import (
-    PAIRINGS,
+from thorvald_design.report.tracks import Drive, parse_tracks
+from thorvald_design.report.views import (
     circle,
     comparisons,
     disagreement,
     disagrees,
     ground_height,
     headland_rows,
+    pairings,
     section_direction,
     side_series,
     side_try,
@@ -109,11 +108,18 @@ def test_the_comparisons_are_the_measured_metrics_with_a_prediction_and_the_stud
     assert gone.measured.startswith("failed") and not gone.numbers
     # a descent's tries: the first failed one
     assert found[1].rows[1].failed_at == 18.0 and found[1].rows[1].failed_how == "ran away"
-    # every pairing's metric is one its scenario reports
+    # every pairing's metric is one its scenario reports: the four the scenarios declare
     from thorvald_design.scenarios import SCENARIOS  # noqa: PLC0415
 
-    for p in PAIRINGS:
+    found = pairings()
+    for p in found:
         assert p.measured in SCENARIOS[p.scenario].results and p.predicted in SCENARIOS[p.scenario].results
+    assert [(p.scenario, p.measured, p.predicted, p.step, p.unit) for p in found] == [
+        ("gradeability", "max_climb_deg", "predicted_climb_deg", "step_deg", "deg"),
+        ("gradeability", "max_descent_deg", "predicted_descent_deg", "step_deg", "deg"),
+        ("side_slope", "max_traverse_deg", "static_overturning_deg", "step_deg", "deg"),
+        ("drawbar", "max_pull_n", "predicted_pull_n", "step_n", "N"),
+    ]
 
 
 def test_the_page_says_a_limit_and_its_prediction_disagree_only_beyond_the_step_and_why():

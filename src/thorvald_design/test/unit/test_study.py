@@ -6,7 +6,7 @@ import textwrap
 import pytest
 import yaml
 
-from thorvald_design.report_table import columns
+from thorvald_design.report.table import columns
 from thorvald_design.study import MAX_CANDIDATES, load_study, parse_study
 from thorvald_model.config import parse_robot_config
 from thorvald_model.errors import ConfigError

@@ -32,7 +32,7 @@ from thorvald_sim.world.surfaces import SURFACE_KINDS
 from ..quasi_static import max_pull
 from .driving import SURFACE_RULE, SURFACES, as_simulated, flat_world, heading_hold, mean, rolling_offset
 from .gradeability import TORQUE_BOUND
-from .kind import ScenarioKind
+from .kind import LARGER, WORDS, Metric, Prediction, ScenarioKind
 
 KEYS = (
     Key(
@@ -50,7 +50,21 @@ KEYS = (
     Key("settle", float, 3.0, check=lambda v: 0.5 <= v <= 30.0, rule="must be in [0.5, 30] [s]"),
     Key("held_speed", float, 0.9, check=lambda v: 0.1 <= v < 1.0, rule="must be in [0.1, 1)"),
 )
-RESULTS = ("max_pull_n", "limited_by", "predicted_pull_n", "surface")
+METRICS = (
+    Metric(
+        "max_pull_n", "N", LARGER, "the largest backward pull held at the command's speed (the first surface's)",
+        Prediction(
+            "predicted_pull_n", "step_n", "", "held",
+            "the model's contacts are points under the wheels' axes where the simulated wheels touch at one rim of "
+            "their contact discs (and a caster's wheel trails its swivel axis), a soft surface's wheels sink, and a "
+            "pull counts as held while the speed stays at held_speed of the command, which a wheel slipping a "
+            "little still meets",
+        ),
+    ),
+    Metric("limited_by", "", WORDS, "what stopped the next pull: traction or motor torque"),
+    Metric("predicted_pull_n", "N", LARGER, "the quasi-static pull its weight distribution, grip and motors allow"),
+    Metric("surface", "", WORDS, "the surface of the headline figures: the first of the study's"),
+)  # fmt: skip
 EACH = ("max_pull_n", "limited_by", "predicted_pull_n")  # per surface, when there are several
 MAX_STEPS = 400  # of the pull: a robot holding 400 steps is out of the scenario's range
 
@@ -140,7 +154,7 @@ DRAWBAR = ScenarioKind(
     name="drawbar",
     what="the largest pull held at walking speed on each surface, and what limited it",
     keys=KEYS,
-    results=RESULTS,
+    metrics=METRICS,
     procedure=procedure,
     more=more,
 )

@@ -35,7 +35,7 @@ from ..energy import Battery, energy_use, motor_power
 from ..route import PurePursuit, field_route
 from .driving import SURFACE_RULE, SURFACES, TIPPED, feasible_twist, flat_world
 from .gradeability import SETTLE
-from .kind import ScenarioKind, not_applicable
+from .kind import LARGER, SMALLER, Metric, ScenarioKind, not_applicable
 from .turning import turn_centre
 
 KEYS = (
@@ -48,7 +48,15 @@ KEYS = (
     Key("regenerative", bool, False),
     Key("start_soc", float, 1.0, check=lambda v: 0.0 < v <= 1.0, rule="must be in (0, 1]"),
 )
-RESULTS = ("wh_per_km", "wh_per_ha", "peak_current_a", "rms_current_a", "end_soc", "range_km")
+METRICS = (
+    Metric("wh_per_km", "Wh/km", SMALLER, "the energy the route took over the distance driven, turns included"),
+    Metric("wh_per_ha", "Wh/ha", SMALLER, "the energy the route took over the area worked"),
+    Metric("peak_current_a", "A", SMALLER, "the largest current drawn from the pack"),
+    Metric("rms_current_a", "A", SMALLER, "the root mean square of the pack's current"),
+    Metric("end_soc", "1", LARGER, "the pack's state of charge left after the route"),
+    Metric("range_km", "km", LARGER, "the distance the pack's charge lasts at the route's rate of use"),
+)
+RESULTS = tuple(m.name for m in METRICS)
 MARGIN = 0.05  # [m] the route's turns are this much wider than the robot's tightest
 
 
@@ -137,6 +145,6 @@ ENERGY = ScenarioKind(
     name="energy",
     what="a field route of rows and headland turns: Wh per km and per hectare, battery current, range",
     keys=KEYS,
-    results=RESULTS,
+    metrics=METRICS,
     procedure=procedure,
 )

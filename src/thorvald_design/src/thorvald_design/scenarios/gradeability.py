@@ -82,7 +82,7 @@ from .driving import (
     rolling_offset,
     series,
 )
-from .kind import ScenarioKind
+from .kind import LARGER, WORDS, Metric, Prediction, ScenarioKind
 
 TORQUE_BOUND = 0.95  # of the motors' torque limit, on average over the last second: the motors are the limit
 PUSHING = 0.1  # of its torque limit: below this a wheel is not pushing (it is off the ground)
@@ -98,16 +98,31 @@ KEYS = (
     Key("ramp_length", float, 3.0, check=lambda v: 0.5 <= v <= 30.0, rule="must be in [0.5, 30] [m] of run"),
     Key("descent", bool, True),
 )
-RESULTS = (
-    "surface",
-    "max_climb_deg",
-    "limited_by",
-    "max_crest_deg",
-    "max_descent_deg",
-    "predicted_climb_deg",
-    "predicted_limited_by",
-    "predicted_descent_deg",
-)
+METRICS = (
+    Metric("surface", "", WORDS, "the ramps' surface kind"),
+    Metric(
+        "max_climb_deg", "deg", LARGER, "the steepest ramp climbed, the foremost wheel at its crest",
+        Prediction(
+            "predicted_climb_deg", "step_deg", "climbs", "climbed",
+            "a soft ramp sinks most under the most loaded wheel, the ramp's foot and crest jolt a robot near its "
+            "limit, and the simulated wheels touch at one rim of their contact discs (the gradeability scenario's "
+            "meaning gives their sizes for the rear-driven tricycle)",
+        ),
+    ),
+    Metric("limited_by", "", WORDS, "what stopped the next climb: traction, motor torque or tipping"),
+    Metric("max_crest_deg", "deg", LARGER, "the steepest ramp whose crest it crossed too (base_link over the top)"),
+    Metric(
+        "max_descent_deg", "deg", LARGER, "the steepest ramp descended under control, its speed near the command",
+        Prediction(
+            "predicted_descent_deg", "step_deg", "descents", "descended",
+            "a descent is held while its speed stays near the command, the wheels braking at speed, where the "
+            "prediction is the wheels' static hold",
+        ),
+    ),
+    Metric("predicted_climb_deg", "deg", LARGER, "the quasi-static climb its weight distribution, grip, motors allow"),
+    Metric("predicted_limited_by", "", WORDS, "what binds the quasi-static climb: traction, motor torque or tipping"),
+    Metric("predicted_descent_deg", "deg", LARGER, "the quasi-static descent its driven wheels hold braking"),
+)  # fmt: skip
 
 
 check = check_series("start_deg", "max_deg")
@@ -263,7 +278,7 @@ GRADEABILITY = ScenarioKind(
     name="gradeability",
     what="the steepest ramp climbed, what limited it, and the steepest descended under control",
     keys=KEYS,
-    results=RESULTS,
+    metrics=METRICS,
     procedure=procedure,
     check=check,
 )

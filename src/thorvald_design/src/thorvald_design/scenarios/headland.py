@@ -42,7 +42,7 @@ from ..metrics import plants_touched
 from ..route import PurePursuit, line, path_of, turn
 from .driving import SURFACE_RULE, SURFACES, TIPPED, feasible_twist, flat_world, track_of
 from .gradeability import SETTLE
-from .kind import ScenarioKind, not_applicable
+from .kind import SMALLER, WORDS, Metric, ScenarioKind, not_applicable
 from .turning import turn_centre
 
 TURNS = ("U", "omega", "crab", "spin")
@@ -60,7 +60,12 @@ KEYS = (
     Key("turns", str, ", ".join(TURNS)),
     Key("surface", str, "grass", check=one_of(*SURFACES), rule=SURFACE_RULE),
 )
-RESULTS = ("min_headland_m", "turn", "plants_touched")
+METRICS = (
+    Metric("min_headland_m", "m", SMALLER, "the narrowest headland of the turns that work, touching the fewest plants"),
+    Metric("turn", "", WORDS, "the turn that gave it: U, omega, crab or spin"),
+    Metric("plants_touched", "plants", SMALLER, "the plants that turn's wheels (and frame, over tall plants) touched"),
+)
+RESULTS = tuple(m.name for m in METRICS)
 
 
 def turn_names(text: str) -> Tuple[str, ...]:
@@ -262,7 +267,7 @@ HEADLAND = ScenarioKind(
     name="headland",
     what="out of a row, a turn and into the next: the narrowest headland that works, the plants touched",
     keys=KEYS,
-    results=RESULTS,
+    metrics=METRICS,
     procedure=procedure,
     check=check,
 )

@@ -26,7 +26,7 @@ from thorvald_model.schema import Key, one_of
 
 from .driving import SURFACE_RULE, SURFACES, Progress, check_series, heading_hold, series, surface_keys
 from .gradeability import SETTLE
-from .kind import ScenarioKind
+from .kind import LARGER, Metric, ScenarioKind
 
 KEYS = (
     Key("surface", str, "tarmac", check=one_of(*SURFACES), rule=SURFACE_RULE),
@@ -36,7 +36,10 @@ KEYS = (
     Key("max_m", float, 0.3, check=lambda v: 0.005 <= v <= 1.0, rule="must be in [0.005, 1] [m]"),
     Key("down", bool, True),
 )
-RESULTS = ("max_step_m", "max_step_down_m")
+METRICS = (
+    Metric("max_step_m", "m", LARGER, "the highest step climbed, the whole robot on it"),
+    Metric("max_step_down_m", "m", LARGER, "the highest step driven down, the whole robot back on the ground"),
+)
 
 
 check = check_series("start_m", "max_m")
@@ -138,7 +141,7 @@ OBSTACLE = ScenarioKind(
     name="obstacle",
     what="the highest step climbed, up and down",
     keys=KEYS,
-    results=RESULTS,
+    metrics=METRICS,
     procedure=procedure,
     check=check,
 )

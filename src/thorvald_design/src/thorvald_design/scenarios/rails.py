@@ -69,7 +69,7 @@ from thorvald_model.schema import Key, one_of
 from thorvald_model.values import RAIL_FLANGE_DEPTH
 
 from .driving import SURFACE_RULE, SURFACES, Progress, heading_hold, surface_keys
-from .kind import Pose, ScenarioKind, not_applicable
+from .kind import SMALLER, Metric, Pose, ScenarioKind, not_applicable
 
 SETTLE = 1.0  # [s] the robot stands before it drives, and after
 ON_RAIL = 0.005  # [m] a wheel centre this near the height a rail wheel on a pipe holds it at rides the pipe
@@ -88,7 +88,16 @@ KEYS = (
     Key("pipe_radius", float, 0.0255, check=lambda v: 0.005 <= v <= 0.1, rule="must be in [0.005, 0.1] [m]"),
     Key("ramp_deg", float, 10.0, check=lambda v: 2.0 <= v <= 25.0, rule="must be in [2, 25] [deg]"),
 )
-RESULTS = ("odometry_error_pct", "odometry_error_pct_without_switch")
+METRICS = (
+    Metric(
+        "odometry_error_pct", "%", SMALLER, "the odometry's distance off ground truth's, the wheel diameter switched"
+    ),
+    Metric(
+        "odometry_error_pct_without_switch", "%", SMALLER,
+        "the odometry's distance off ground truth's, the floor's wheel diameter throughout",
+    ),
+)  # fmt: skip
+RESULTS = tuple(m.name for m in METRICS)
 
 
 def check(values: Mapping[str, Any], path: str, problems: List[Problem]) -> None:
@@ -338,7 +347,7 @@ RAILS = ScenarioKind(
     name="rails",
     what="base_driver's odometry error along greenhouse heating pipes, with and without the wheel diameter switched",
     keys=KEYS,
-    results=RESULTS,
+    metrics=METRICS,
     procedure=procedure,
     check=check,
 )

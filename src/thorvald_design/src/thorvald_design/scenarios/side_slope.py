@@ -37,7 +37,7 @@ from ..metrics import lateral_drift
 from ..quasi_static import overturning_angles
 from .driving import SURFACE_RULE, SURFACES, Progress, as_simulated, check_series, heading_hold, track_of
 from .gradeability import SETTLE, angles
-from .kind import ScenarioKind
+from .kind import LARGER, SMALLER, Metric, Prediction, ScenarioKind
 
 KEYS = (
     Key("surface", str, "grass", check=one_of(*SURFACES), rule=SURFACE_RULE),
@@ -48,7 +48,19 @@ KEYS = (
     Key("distance", float, 5.0, check=lambda v: 1.0 <= v <= 100.0, rule="must be in [1, 100] [m]"),
     Key("max_drift", float, 0.05, check=lambda v: 0.0 < v <= 1.0, rule="must be in (0, 1] [m per m]"),
 )
-RESULTS = ("max_traverse_deg", "static_overturning_deg", "drift_per_m")
+METRICS = (
+    Metric(
+        "max_traverse_deg", "deg", LARGER, "the steepest side slope held both ways along its contour",
+        Prediction(
+            "static_overturning_deg", "step_deg", "traverses", "held",
+            "a traverse fails by sliding downhill (more than max_drift a metre) before it tips, which the static "
+            "overturning angle, a bound on tipping alone, does not count; one that tips is driven at speed across "
+            "soft ground, which sinks most under its downhill wheels, its heading held by steering",
+        ),
+    ),
+    Metric("static_overturning_deg", "deg", LARGER, "ISO 16231-2's static overturning angle, the weaker side"),
+    Metric("drift_per_m", "m/m", SMALLER, "the downhill drift per metre along the steepest slope held"),
+)  # fmt: skip
 
 
 check = check_series("start_deg", "max_deg")
@@ -161,7 +173,7 @@ SIDE_SLOPE = ScenarioKind(
     name="side_slope",
     what="across slopes holding a heading: drift per metre, the steepest held, the static overturning angle",
     keys=KEYS,
-    results=RESULTS,
+    metrics=METRICS,
     procedure=procedure,
     check=check,
 )

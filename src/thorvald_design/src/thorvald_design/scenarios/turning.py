@@ -34,9 +34,11 @@ from typing import Any, Dict, List, Mapping, Sequence, Tuple
 from thorvald_model.layout import axle_lines
 from thorvald_model.schema import Key, one_of
 
-from ..metrics import convex_hull, turning_diameters
+from ..errors import ScenarioError
+from ..geometry import convex_hull
+from ..metrics import turning_diameters
 from .driving import SURFACE_RULE, SURFACES, flat_world, track_of
-from .kind import ScenarioKind
+from .kind import SMALLER, WORDS, Metric, ScenarioKind
 
 CENTRE_STEP = 0.005  # [m] the centre moves out in these steps until every steered wheel can stand
 MAX_CENTRE = 50.0  # [m]: a robot that cannot turn tighter than this cannot turn
@@ -46,7 +48,11 @@ KEYS = (
     Key("surface", str, "tarmac", check=one_of(*SURFACES), rule=SURFACE_RULE),
     Key("settle", float, 3.0, check=lambda v: 0.0 <= v <= 30.0, rule="must be in [0, 30] [s]"),
 )
-RESULTS = ("turning_diameter_m", "clearance_diameter_m", "turn")
+METRICS = (
+    Metric("turning_diameter_m", "m", SMALLER, "ISO 789-3: the outermost wheel contact's circle, the larger way"),
+    Metric("clearance_diameter_m", "m", SMALLER, "the circle of the robot's outermost point, the larger way"),
+    Metric("turn", "", WORDS, "the turn: spin on the spot, or about a point of the axle line"),
+)
 
 
 def turn_centre(drives: Sequence, passive_wheels: Sequence = ()) -> Tuple[Tuple[float, float], str]:
@@ -66,7 +72,7 @@ def turn_centre(drives: Sequence, passive_wheels: Sequence = ()) -> Tuple[Tuple[
             c = (base[0] + sign * k * CENTRE_STEP * direction[0], base[1] + sign * k * CENTRE_STEP * direction[1])
             if _steerable(drives, c):
                 return c, turn if k == 0 else turn + f", {k * CENTRE_STEP:.3f} m out (steering limits)"
-    raise ValueError(f"no centre of rotation within {MAX_CENTRE} m suits every drive's steering limit")
+    raise ScenarioError(f"no centre of rotation within {MAX_CENTRE} m suits every drive's steering limit")
 
 
 def _steerable(drives: Sequence, centre: Tuple[float, float]) -> bool:
@@ -142,6 +148,6 @@ TURNING = ScenarioKind(
     name="turning",
     what="ISO 789-3 turning and clearance diameters of the tightest turn, both ways, at 2 km/h",
     keys=KEYS,
-    results=RESULTS,
+    metrics=METRICS,
     procedure=procedure,
 )

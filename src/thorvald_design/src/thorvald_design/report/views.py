@@ -6,6 +6,10 @@ Pure: results.json's values and the tracks files' contents in, numbers and sente
 numpy, :mod:`thorvald_design.metrics` and the world's parser; no matplotlib, no pybullet), so that what
 a plot carries is unit-tested without drawing it.
 
+Which metrics have a prediction, in what unit, with what step and what else parts them, is each
+scenario's declaration (:class:`thorvald_design.scenarios.kind.Prediction`), read from the registry
+when the report is made: a scenario registered later is compared as the built-in ones are.
+
 A series measures a limit in steps (ramps every ``step_deg``, pulls every ``step_n``): the value it
 reports is the last try held, so a limit the prediction has right lies between it and the first try
 that failed, at most a step above it. The page says a measured limit and its prediction disagree
@@ -21,10 +25,10 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .metrics import Track, body_point_path, convex_hull
-from .report_table import columns
-
-Point = Tuple[float, float]
+from ..geometry import Point, convex_hull, in_world
+from ..metrics import Track, body_point_path
+from ..scenarios import SCENARIOS
+from .table import columns
 
 
 def _number(value: Any) -> Optional[float]:
@@ -41,45 +45,30 @@ def _g(value: float, digits: int = 4) -> str:
 # ---- measured against predicted ----------------------------------------------------------------------
 @dataclass(frozen=True)
 class Pairing:
-    """A measured metric and the quasi-static figure it is to agree with."""
+    """A measured metric and the quasi-static figure it is to agree with: its scenario's declaration
+    (:class:`~thorvald_design.scenarios.kind.Metric` and its
+    :class:`~thorvald_design.scenarios.kind.Prediction`) as the report reads it."""
 
     scenario: str
     measured: str  # the metric ("max_climb_deg")
     predicted: str  # its prediction's ("predicted_climb_deg")
     step: str  # the scenario's parameter that is the series' step ("step_deg")
-    unit: str  # "deg", "N"
+    unit: str  # "deg", "N": the measured metric's
     tries: str = ""  # the key of the scenario's tries ("climbs": [value, outcome, ...] each)
     held: str = "held"  # what the measured value is, in a sentence: "climbed", "pulled"
     # what else parts them, from the metric's meaning (the scenario's docstring)
     rest: str = ""
 
 
-PAIRINGS: Tuple[Pairing, ...] = (
-    Pairing(
-        "gradeability", "max_climb_deg", "predicted_climb_deg", "step_deg", "deg", "climbs", "climbed",
-        "a soft ramp sinks most under the most loaded wheel, the ramp's foot and crest jolt a robot near its "
-        "limit, and the simulated wheels touch at one rim of their contact discs (the gradeability scenario's "
-        "meaning gives their sizes for the rear-driven tricycle)",
-    ),
-    Pairing(
-        "gradeability", "max_descent_deg", "predicted_descent_deg", "step_deg", "deg", "descents", "descended",
-        "a descent is held while its speed stays near the command, the wheels braking at speed, where the "
-        "prediction is the wheels' static hold",
-    ),
-    Pairing(
-        "drawbar", "max_pull_n", "predicted_pull_n", "step_n", "N", "", "held",
-        "the model's contacts are points under the wheels' axes where the simulated wheels touch at one rim of "
-        "their contact discs (and a caster's wheel trails its swivel axis), a soft surface's wheels sink, and a "
-        "pull counts as held while the speed stays at held_speed of the command, which a wheel slipping a "
-        "little still meets",
-    ),
-    Pairing(
-        "side_slope", "max_traverse_deg", "static_overturning_deg", "step_deg", "deg", "traverses", "held",
-        "a traverse fails by sliding downhill (more than max_drift a metre) before it tips, which the static "
-        "overturning angle, a bound on tipping alone, does not count; one that tips is driven at speed across "
-        "soft ground, which sinks most under its downhill wheels, its heading held by steering",
-    ),
-)  # fmt: skip
+def pairings() -> Tuple[Pairing, ...]:
+    """Every measured metric with a prediction, of the scenarios registered now, in their order."""
+    out = []
+    for kind in SCENARIOS.values():
+        for m in kind.metrics:
+            p = m.prediction
+            if p is not None:
+                out.append(Pairing(kind.name, m.name, p.metric, p.step, m.unit, p.tries, p.held, p.rest))
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -143,11 +132,12 @@ def comparisons(results: Mapping[str, Any], study) -> List[Comparison]:
     in the table's order (a drawbar surface's columns too)."""
     known = columns(study)
     params = dict(study.scenarios)
+    paired = {(p.scenario, p.measured): p for p in pairings()}
     out = []
     for column in known:
         scenario, metric = column.split(".", 1)
         name, dot, suffix = metric.partition(".")
-        pairing = next((p for p in PAIRINGS if p.scenario == scenario and p.measured == name), None)
+        pairing = paired.get((scenario, name))
         predicted_column = f"{scenario}.{pairing.predicted}{dot}{suffix}" if pairing else ""
         if pairing is None or predicted_column not in known:
             continue
@@ -282,11 +272,6 @@ def _track(drive) -> Track:
     return Track(np.array(t, float), np.array(drive.x, float), np.array(drive.y, float), np.array(drive.yaw, float))
 
 
-def _in_world(x: float, y: float, yaw: float, points: Sequence[Point]) -> Tuple[Point, ...]:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return tuple((x + c * px - s * py, y + s * px + c * py) for px, py in points)
-
-
 def turn_view(drive) -> Optional[TurnView]:
     """The turn of a drive whose marks are a turning scenario's (``centre``, ``outer_wheel``, both
     diameters, ``outline``); None for any other drive, or one without headings."""
@@ -313,9 +298,9 @@ def turn_view(drive) -> Optional[TurnView]:
         clearance,
         str(wheel[0]),
         path,
-        _in_world(*pose, hull),
-        _in_world(*pose, [(float(outer[0]), float(outer[1]))])[0],
-        _in_world(*pose, [(float(wheel[1]), float(wheel[2]))])[0],
+        in_world(*pose, hull),
+        in_world(*pose, [(float(outer[0]), float(outer[1]))])[0],
+        in_world(*pose, [(float(wheel[1]), float(wheel[2]))])[0],
     )
 
 
@@ -488,7 +473,6 @@ def turn_legend(marks: Mapping[str, Any]) -> str:
 
 
 __all__ = [
-    "PAIRINGS",
     "Compared",
     "Comparison",
     "Pairing",
@@ -501,6 +485,7 @@ __all__ = [
     "disagrees",
     "ground_height",
     "headland_rows",
+    "pairings",
     "section_direction",
     "side_series",
     "side_try",
