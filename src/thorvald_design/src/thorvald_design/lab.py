@@ -1,16 +1,16 @@
 """Where a scenario drives a candidate: a simulation of the candidate's own in a world the scenario
 writes (:class:`Lab`, :class:`LabSession`), on the simulator library's runner
 (:class:`thorvald_sim.runner.RobotSession`): the candidate's own base_driver core on drives measured
-from the simulated joints, in lockstep, seeded, without a ROS master.
+from the simulated joints, in lockstep, seeded, without a ROS master. Everything it reads of the
+robot (pose, outline, centre of mass, motor and wheel loads, a picture) the session offers.
 
-Not pure: it runs pybullet (one DIRECT client a session, closed at its end).
+Not pure: its session runs pybullet (one DIRECT client a session, closed at its end).
 """
 
 import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
-from thorvald_sim.bullet import pybullet as p
 from thorvald_sim.robot import MotorLoad
 from thorvald_sim.runner import RobotSession, RunOptions, Sample
 from thorvald_sim.simulation import Camera, save_png
@@ -60,17 +60,16 @@ class LabSession:
         return self._session.run(until, command, cycle)
 
     def pose(self) -> Pose:
-        position, orientation = self._session.robot.world_pose()
-        roll, pitch, yaw = p.getEulerFromQuaternion(orientation)
+        x, y, z, roll, pitch, yaw = self._session.pose()
         # pybullet's pitch is about y, positive nose down; a climb is nose up
-        return Pose(self._session.time, position[0], position[1], position[2], roll, -pitch, yaw)
+        return Pose(self._session.time, x, y, z, roll, -pitch, yaw)
 
     def motor_loads(self) -> List[MotorLoad]:
-        return self._session.robot.motor_torques()
+        return self._session.motor_torques()
 
     def wheel_loads(self) -> List[float]:
         """[N] the ground's normal force on each drive's wheel, in drive order."""
-        return self._session.robot.wheel_loads()
+        return self._session.wheel_loads()
 
     def push(self, force: Optional[Sequence[float]], at: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
         self._session.push(force, at)
@@ -80,7 +79,7 @@ class LabSession:
         does on a robot (:meth:`thorvald_base.core.BaseDriverCore.set_drive_params`): each change
         (drive index, key, value) validated as the robot file is, used from the next control cycle on.
         Returns the problems of the changes refused (the others are applied)."""
-        return self._session.core.set_drive_params(changes)[1]
+        return self._session.set_drive_params(changes)
 
     @property
     def odometry(self) -> List[Sample]:
@@ -88,19 +87,8 @@ class LabSession:
         return self._session.odometry
 
     def _outline(self) -> Tuple[Tuple[float, float], ...]:
-        """The corners in plan of every link's bounding box at the spawn pose, in base_link [m]: the
-        robot's outermost points (the frame, the wheels, what it carries)."""
-        robot = self._session.robot
-        (x0, y0, _), orientation = robot.world_pose()
-        yaw = p.getEulerFromQuaternion(orientation)[2]
-        c, s = math.cos(yaw), math.sin(yaw)
-        points = []
-        for link in range(-1, p.getNumJoints(robot.body, physicsClientId=robot.client)):
-            lo, hi = p.getAABB(robot.body, link, physicsClientId=robot.client)
-            for x, y in ((lo[0], lo[1]), (lo[0], hi[1]), (hi[0], lo[1]), (hi[0], hi[1])):
-                dx, dy = x - x0, y - y0
-                points.append((c * dx + s * dy, -s * dx + c * dy))
-        return tuple(points)
+        """The corners in plan of every link's bounding box at the spawn pose, in base_link [m]."""
+        return self._session.outline()
 
     def _centre_of_mass(self) -> Tuple[float, float, float]:
         """[m] the simulated robot's centre of mass in base_link at the spawn pose: every body's mass
@@ -108,28 +96,15 @@ class LabSession:
         at its centre (thorvald_sim.description.centre_fixed_links); measured, so that a fault of the
         loading would show beside the prediction, as pybullet's merge of fixed links did (3.9 cm
         higher on the example three-wheelers)."""
-        robot = self._session.robot
-        body, client = robot.body, robot.client
-        to_base_link = p.invertTransform(*robot.world_pose())
-        total, moment = 0.0, [0.0, 0.0, 0.0]
-        for link in range(-1, p.getNumJoints(body, physicsClientId=client)):
-            mass = p.getDynamicsInfo(body, link, physicsClientId=client)[0]
-            if link < 0:
-                where = p.getBasePositionAndOrientation(body, physicsClientId=client)[0]
-            else:
-                where = p.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=client)[0]
-            local = p.multiplyTransforms(*to_base_link, where, (0.0, 0.0, 0.0, 1.0))[0]
-            total += mass
-            moment = [m + mass * v for m, v in zip(moment, local)]
-        return tuple(m / total for m in moment) if total > 0.0 else (0.0, 0.0, 0.0)
+        return self._session.centre_of_mass()
 
     def picture(self, path: str, width: int = 480, height: int = 360) -> None:
         """A PNG of the robot where it stands, from its front left and above (pybullet's software renderer)."""
-        (x, y, z), _ = self._session.robot.world_pose()
+        x, y, z = self._session.pose()[:3]
         reach = max(math.hypot(px, py) for px, py in self.outline) + 0.5
         camera = Camera(eye=(x + 1.6 * reach, y + 1.2 * reach, z + 1.3 * reach), target=(x, y, z + 0.45),
                         width=width, height=height, fov=45.0)  # fmt: skip
-        save_png(self._session.sim.render(camera), path)
+        save_png(self._session.render(camera), path)
 
     def close(self) -> None:
         if self.on_close is not None:

@@ -56,9 +56,9 @@ from thorvald_model.errors import MISSING, ConfigError, Problem
 
 from .as_built import as_built_for, for_simulator
 from .bullet import pybullet as p
+from .engine import Engine, WorldSettings
 from .physics import physics_settings
 from .robot import Pose2D, Vec3
-from .simulation import Simulation
 from .world import WorldConfig, load_world, resolve_world
 
 WHAT = "list of commands"
@@ -271,13 +271,15 @@ class RobotSession:
         as_built = for_simulator(as_built_for(options.as_built, config), config) if options.as_built else None
         physics = physics_settings(options.physics, options.physics_rate, options.solver_iterations)  # ValueError
         self.world = world if world is not None else load_world(resolve_world(options.world))
-        self.client = client = p.connect(p.DIRECT)
+        # its world made as the simulator node makes its own (thorvald_sim.engine): a DIRECT client
+        rate, iterations = physics.rate, physics.solver_iterations
+        settings = WorldSettings(self.world, rate, seed=options.seed, solver_iterations=iterations)
+        self.engine = Engine(settings)
+        self.client = self.engine.client
+        self.sim = self.engine.sim
         try:
-            self.sim = sim = Simulation(
-                client, self.world, physics.rate, seed=options.seed, solver_iterations=physics.solver_iterations
-            )
             pose = Pose2D(options.x, options.y, options.z, options.yaw, options.roll, options.pitch)
-            self.robot = sim.spawn(options.robot_name, urdf, pose, as_built)
+            self.robot = self.sim.spawn(options.robot_name, urdf, pose, as_built)
             calculator = load_calculator(config, estimator=driver.estimator, projection=driver.projection)
             self.drives = _SimulatedDrives(self.robot)
             handle = create_base_handle(config, driver, _InProcessPorts(self.drives))
@@ -285,8 +287,9 @@ class RobotSession:
             if options.calibration:
                 apply_calibration(self.core, options.calibration)
         except BaseException:
-            p.disconnect(client)
+            self.engine.close()
             raise
+        sim = self.sim
         self.steps = LockstepCycles(self.core, driver.rate)
         self.clock = RateGrid(options.clock_rate, sim.dt)
         self.truth: List[Sample] = []
@@ -301,6 +304,62 @@ class RobotSession:
     def time(self) -> float:
         """[s] simulated."""
         return self.sim.time
+
+    # ---- what a caller reads of the robot between runs ------------------------------------------
+    def pose(self) -> Tuple[float, float, float, float, float, float]:
+        """base_link in the world: (x, y, z) [m] and (roll, pitch, yaw) [rad], pybullet's Euler angles
+        (pitch about y: positive is nose down)."""
+        position, orientation = self.robot.world_pose()
+        return (*position, *p.getEulerFromQuaternion(orientation))
+
+    def motor_torques(self):
+        """Each drive's steering and wheel motor torques (thorvald_sim.robot.MotorLoad), in drive order."""
+        return self.robot.motor_torques()
+
+    def wheel_loads(self) -> List[float]:
+        """[N] the ground's normal force on each drive's wheel, in drive order."""
+        return self.robot.wheel_loads()
+
+    def outline(self) -> Tuple[Tuple[float, float], ...]:
+        """The corners in plan of every link's bounding box, in base_link [m]: the robot's outermost
+        points (the frame, the wheels, what it carries)."""
+        robot, c = self.robot, self.client
+        (x0, y0, _), orientation = robot.world_pose()
+        yaw = p.getEulerFromQuaternion(orientation)[2]
+        cy, sy = math.cos(yaw), math.sin(yaw)
+        points = []
+        for link in range(-1, p.getNumJoints(robot.body, physicsClientId=c)):
+            lo, hi = p.getAABB(robot.body, link, physicsClientId=c)
+            for x, y in ((lo[0], lo[1]), (lo[0], hi[1]), (hi[0], lo[1]), (hi[0], hi[1])):
+                dx, dy = x - x0, y - y0
+                points.append((cy * dx + sy * dy, -sy * dx + cy * dy))
+        return tuple(points)
+
+    def centre_of_mass(self) -> Vec3:
+        """[m] the robot's centre of mass in base_link: every body's mass where pybullet holds it."""
+        body, c = self.robot.body, self.client
+        to_base_link = p.invertTransform(*self.robot.world_pose())
+        total, moment = 0.0, [0.0, 0.0, 0.0]
+        for link in range(-1, p.getNumJoints(body, physicsClientId=c)):
+            mass = p.getDynamicsInfo(body, link, physicsClientId=c)[0]
+            if link < 0:
+                where = p.getBasePositionAndOrientation(body, physicsClientId=c)[0]
+            else:
+                where = p.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=c)[0]
+            local = p.multiplyTransforms(*to_base_link, where, (0.0, 0.0, 0.0, 1.0))[0]
+            total += mass
+            moment = [m + mass * v for m, v in zip(moment, local)]
+        return tuple(m / total for m in moment) if total > 0.0 else (0.0, 0.0, 0.0)
+
+    def set_drive_params(self, changes) -> List[str]:
+        """Drive parameters changed while it runs, as base_driver's ``set_drive_params`` (each change
+        (drive index, key, value) validated as the robot file is, used from the next control cycle
+        on): the problems of the changes refused (the others are applied)."""
+        return self.core.set_drive_params(changes)[1]
+
+    def render(self, camera):
+        """An RGB image of the world as it is (thorvald_sim.simulation.Camera; software renderer)."""
+        return self.sim.render(camera)
 
     def push(self, force: Optional[Sequence[float]], at: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
         """A force [N] in world axes on the frame at the point ``at`` [m] of base_link, every physics
@@ -358,7 +417,7 @@ class RobotSession:
         try:
             self.core.shutdown(self.sim.time)
         finally:
-            p.disconnect(self.client)
+            self.engine.close()
 
     def __enter__(self) -> "RobotSession":
         return self
