@@ -59,6 +59,7 @@ CALL_TIME_ROS = {
     "thorvald_bringup.calibration_drive_cli": "a command that calibrates from the recorded bag (genpy) after the drive",
     "thorvald_sim.sensor_kinds.model": "the sensor kinds' models call pybullet; their block readers never load it",
     "thorvald_sim.world.bodies": "the world kinds' scene builders call pybullet; their values and parsers do not",
+    "thorvald_sim.models.build": "a model is built in pybullet; its readers and values never load it",
     "thorvald_design.runs": "a study's run (in a worker process) drives its candidate in the simulator",
 }
 FORBIDDEN = ["rospy", "genpy", "pybullet", "thorvald_msgs", "geometry_msgs", "nav_msgs", "sensor_msgs", "tf2_ros"]

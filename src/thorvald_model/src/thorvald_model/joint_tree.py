@@ -153,6 +153,14 @@ def compose(a: Transform, b: Transform) -> Transform:
     return (ax + bx, ay + by, az + bz), quaternion_multiply(qa, b[1])
 
 
+def inverse(t: Transform) -> Transform:
+    """The inverse transform: ``compose(t, inverse(t))`` is the identity."""
+    (x, y, z), (qx, qy, qz, qw) = t
+    conj = (-qx, -qy, -qz, qw)
+    tx, ty, tz = rotate(conj, (x, y, z))
+    return (-tx, -ty, -tz), conj
+
+
 class JointTree:
     """The transforms of a robot description's joints, as robot_state_publisher computes them."""
 

@@ -35,3 +35,14 @@ class BlockError(ThorvaldSimError):
         super().__init__(f"{path}: {rule}")
         self.path = path
         self.rule = rule
+
+
+class ModelError(SpawnError):
+    """A model (an SDF ``<model>`` or a URDF that is not a Thorvald robot) that cannot be read or built:
+    where it came from, the element path of the problem, and the rule it breaks."""
+
+    def __init__(self, source: str, path: str, rule: str):
+        super().__init__(f"{source}: {path}: {rule}" if path else f"{source}: {rule}")
+        self.source = source
+        self.path = path
+        self.rule = rule
