@@ -3,7 +3,7 @@
 Users' sensor xacros (``model_extras``) carry Gazebo blocks: ``<gazebo reference="LINK"><sensor
 type=... name=...>`` with a gazebo_ros plugin inside, and ``<gazebo><plugin>`` model plugins. Each
 block goes to the reader of the sensor kind that claims it (:mod:`thorvald_sim.sensor_kinds`: laser,
-multilayer, imu, gps, camera, depth, p3d; the table in docs/sensors.md), which reads it with the
+multilayer, imu, gps, camera, depth, p3d, bumper; the table in docs/sensors.md), which reads it with the
 plugin's own parameter names and defaults (gazebo_ros_pkgs for ROS 1, hector_gazebo_plugins,
 velodyne_gazebo_plugins), so a block written for Gazebo means the same here.
 
@@ -70,7 +70,7 @@ from .sensor_kinds.p3d import P3dConfig
 
 @dataclass(frozen=True)
 class Unsupported:
-    what: str  # e.g. "sensor contact 'bumper' (libgazebo_ros_bumper.so)"
+    what: str  # e.g. "sensor contact 'touch' (libContactPlugin.so)"
     link: str  # "" for a model plugin
 
 
@@ -91,7 +91,7 @@ class SensorBlocks:
     refused: Tuple[Refused, ...] = ()
 
 
-def _sensor(element: ET.Element, link: str) -> SensorSpec:
+def _sensor(element: ET.Element, link: str, root: ET.Element) -> SensorSpec:
     sensor_type = element.get("type", "")
     name = element.get("name", "")
     sensor = Element(element, f"sensor[@name='{name}']")
@@ -102,7 +102,7 @@ def _sensor(element: ET.Element, link: str) -> SensorSpec:
         kind = kind_of_sensor(sensor_type, filename)
         if kind is not None:
             plugin_element = Element(plugin, f"{sensor.path}/plugin[@filename='{filename}']")
-            return kind.read_sensor(Found(sensor, plugin_element, link, name, filename, rate))
+            return kind.read_sensor(Found(sensor, plugin_element, link, name, filename, rate, root))
     what = ", ".join(p.get("filename", "?") for p in plugins) or "no plugin"
     raise _NotSimulated(f"sensor {sensor_type} {name!r} ({what})")
 
@@ -137,7 +137,7 @@ def read_sensor_blocks(xml: Union[str, ET.Element]) -> SensorBlocks:
                                            "the link is not in the description"))  # fmt: skip
                     continue
                 try:
-                    sensors.append(_sensor(element, link))
+                    sensors.append(_sensor(element, link, root))
                 except _NotSimulated as e:
                     unsupported.append(Unsupported(str(e), link))
                 except BlockError as e:

@@ -155,7 +155,7 @@ class SimSensorsTest(SimSensorRatesTest):
         urdf = """<robot name="odd"><link name="odd_base">
           <inertial><mass value="0"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>
           <gazebo reference="odd_base"><sensor type="contact" name="bumper">
-            <plugin name="bumper_plugin" filename="libgazebo_ros_bumper.so"/></sensor>
+            <plugin name="bumper_plugin" filename="libContactPlugin.so"/></sensor>
           <sensor type="ray" name="broken_lidar"><update_rate>10</update_rate>
             <ray><scan><horizontal><min_angle>0</min_angle><max_angle>1</max_angle></horizontal></scan>
             <range><min>0.1</min><max>10</max></range></ray>

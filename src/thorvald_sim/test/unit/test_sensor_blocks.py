@@ -117,12 +117,12 @@ def test_a_broken_block_refuses_that_sensor_only(broken, path, rule):
 
 def test_other_sensors_and_plugins_are_listed_by_name_and_link():
     contact = """<gazebo reference="imu_link"><sensor type="contact" name="bumper">
-      <plugin name="b" filename="libgazebo_ros_bumper.so"/></sensor></gazebo>"""
+      <plugin name="b" filename="libContactPlugin.so"/></sensor></gazebo>"""
     model = """<gazebo><plugin name="mover" filename="libgazebo_ros_planar_move.so"/></gazebo>"""
     blocks = read_sensor_blocks(robot(contact, model))
     assert not blocks.sensors
     assert [(u.what, u.link) for u in blocks.unsupported] == [
-        ("sensor contact 'bumper' (libgazebo_ros_bumper.so)", "imu_link"),
+        ("sensor contact 'bumper' (libContactPlugin.so)", "imu_link"),
         ("model plugin 'mover' (libgazebo_ros_planar_move.so)", ""),
     ]
 

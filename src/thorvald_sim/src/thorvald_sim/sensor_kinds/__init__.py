@@ -17,7 +17,7 @@ when it is made; two kinds claiming one block, when they are registered.
 from contextlib import contextmanager
 from typing import Iterator, List, Optional, Sequence, Tuple
 
-from . import camera, gnss, imu, lidar, p3d
+from . import bumper, camera, gnss, imu, lidar, p3d
 from .kind import SensorKind, SensorKindError
 
 BUILT_IN: Tuple[SensorKind, ...] = (
@@ -28,6 +28,7 @@ BUILT_IN: Tuple[SensorKind, ...] = (
     camera.CAMERA,
     camera.DEPTH,
     p3d.P3D,
+    bumper.BUMPER,
 )
 
 _kinds: List[SensorKind] = list(BUILT_IN)  # BUILT_IN, then the kinds registered() added

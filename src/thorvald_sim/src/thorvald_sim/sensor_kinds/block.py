@@ -158,6 +158,7 @@ class Found:
     name: str
     filename: str
     rate: float  # the sensor's <update_rate> [Hz]
+    robot: Optional[ET.Element] = None  # the description's <robot> (a bumper finds its collisions there)
 
 
 def unpack(found: "Found"):
