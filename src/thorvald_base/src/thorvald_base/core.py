@@ -147,7 +147,9 @@ class BaseDriverCore:
         stopped_by = "homing" if self.handle.homing else None
         changed, scale = False, 1.0
         cmd = self._command
-        if cmd.time is None or time - cmd.time > self.command_timeout:
+        # a command more than a timeout ahead of time: time moved backwards (a simulation reset), and
+        # no command has come since
+        if cmd.time is None or abs(time - cmd.time) > self.command_timeout:
             stopped_by = stopped_by or "timeout"
             commands = self.calculator.set_zero_speed(self._last_commands)
         else:

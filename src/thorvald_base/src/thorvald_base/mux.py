@@ -88,7 +88,9 @@ class TwistMux:
     def _expired(source: Source, stamp: Optional[float], now: float) -> bool:
         if source.timeout <= 0.0:
             return False
-        return stamp is None or now - stamp > source.timeout
+        # a stamp more than a timeout ahead of now: time moved backwards (a simulation reset), and
+        # nothing heard since is fresh
+        return stamp is None or abs(now - stamp) > source.timeout
 
     def lock_priority(self, now: float) -> int:
         """Highest priority among the locked locks; -1 when none is locked."""

@@ -36,7 +36,7 @@ class TwistMuxNode:
         self.subs += [rospy.Subscriber(names.topic(s.topic), Bool, self.on_lock, s.name, queue_size=1) for s in locks]
         rate = float(rospy.get_param(names.param("diagnostics_rate"), 1.0))
         if rate > 0:
-            self.timer = rospy.Timer(rospy.Duration(1.0 / rate), self.publish_diagnostics)
+            self.timer = rospy.Timer(rospy.Duration(1.0 / rate), self.publish_diagnostics, reset=True)
         # the topics as subscribed, remappings applied (a launch file may remap nav_vel)
         rospy.loginfo(
             "%s: inputs %s; locks %s",

@@ -51,6 +51,16 @@ def test_old_command_stops_the_wheels_and_keeps_the_steering():
     assert all(c.speed == 0.0 and c.steering == pytest.approx(math.pi / 2) for c in r.commands)
 
 
+def test_a_command_from_before_time_moved_backwards_stops_the_wheels():
+    core = make_core()
+    _, r = run(core, 100.0, 1.0, (0.5, 0.0, 0.0))
+    assert r.stopped_by is None
+    _, r = run(core, 0.0, 0.1)  # a simulation reset to zero: the command is 100 s "ahead", nothing since
+    assert r.stopped_by == "timeout" and all(c.speed == 0.0 for c in r.commands)
+    _, r = run(core, 0.1, 0.5, (0.5, 0.0, 0.0))  # a command heard after the reset drives again
+    assert r.stopped_by is None
+
+
 @pytest.mark.parametrize("bad", [(math.nan, 0, 0), (0, math.inf, 0), (0, 0, -math.inf)])
 def test_non_finite_command_is_refused_and_the_previous_one_stands(bad):
     core = make_core()

@@ -25,6 +25,15 @@ def test_lower_priority_passes_once_the_higher_one_times_out():
     assert mux.on_input("navigation", 0.51)
 
 
+def test_after_time_moved_backwards_an_input_heard_before_is_expired():
+    mux = TwistMux([JOY, NAV])
+    mux.on_input("joystick", 100.0)
+    assert mux.selected(100.2) == "joystick"
+    assert mux.selected(0.1) is None  # a simulation reset: the joystick was heard 99.9 s "ahead"
+    assert mux.on_input("navigation", 0.2)
+    assert mux.on_input("joystick", 0.3) and mux.selected(0.4) == "joystick"
+
+
 def test_inputs_with_a_timeout_start_expired():
     mux = TwistMux([JOY, NAV])
     assert mux.selected(0.0) is None

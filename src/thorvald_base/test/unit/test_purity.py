@@ -31,6 +31,8 @@ NOT_PURE = {
     "thorvald_sim.sensor_io": "the simulator node's sensor topics",
     "thorvald_sim.robot_io": "the simulator node's robot topics and tf",
     "thorvald_sim.services": "the simulator node's services",
+    "thorvald_sim.gazebo.api": "the simulator node's Gazebo API: services, topics, messages",
+    "thorvald_sim.gazebo.bodies": "the Gazebo API in a world's bodies (pybullet)",
     "thorvald_teleop.joy_node": "a node",
     "thorvald_teleop.teleop_node": "a node",
     "thorvald_teleop.keyboard_node": "a node",

@@ -69,6 +69,14 @@ class CommandSlot:
                 return HOLD, None
         return None, None
 
+    def restart_time(self) -> None:
+        """Simulated time went back to zero: the latest command counts as come at 0 (the timeout
+        runs from there), and no stamp of the old time is behind or ahead of the new."""
+        with self.lock:
+            if self.time is not None:
+                self.time = 0.0
+            self.stamp = None
+
     def lagging(self, now: float, max_lag: float) -> bool:
         """Whether the command stream is alive but more than max_lag [s] behind simulated time now."""
         with self.lock:

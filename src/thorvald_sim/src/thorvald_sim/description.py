@@ -150,7 +150,7 @@ def description_of(root: ET.Element) -> RobotDescription:
                     _float(g.findtext("springReference"), f"joint {ref} springReference"),
                 )
             )
-    plugin = next((p for g in root.findall("gazebo") for p in g.findall("plugin") if p.findall("drive")), None)
+    plugin = _drive_block(root)
     if plugin is None:
         return RobotDescription(root.get("name", ""), joints, (), tuple(springs))
     drives = []
@@ -391,6 +391,21 @@ class MissingMesh:
 
 MeshFinder = Callable[[str], Tuple[Optional[str], str]]
 """uri -> (absolute path of the file, "") or (None, why it cannot be found)."""
+
+
+def _drive_block(root: ET.Element) -> Optional[ET.Element]:
+    """The generator's simulator block: the ``<gazebo><plugin>`` with ``<drive>`` elements, or None."""
+    return next((p for g in root.findall("gazebo") for p in g.findall("plugin") if p.findall("drive")), None)
+
+
+def is_thorvald_robot(xml: str) -> bool:
+    """Whether a description is a Thorvald robot's: a URDF with the generator's simulator block
+    (the Gazebo API spawns it as ``spawn_robot`` does; any other model as a model)."""
+    try:
+        root = ET.fromstring(xml)
+    except ET.ParseError:
+        return False
+    return root.tag == "robot" and _drive_block(root) is not None
 
 
 def resolve_meshes(xml: str, find: MeshFinder) -> Tuple[str, Tuple[MissingMesh, ...]]:

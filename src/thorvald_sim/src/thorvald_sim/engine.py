@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
 from .errors import SpawnError
+from .gazebo.bodies import GazeboBodies
 from .robot import TYRE_CONTACT_WIDTH, Pose2D
 from .sensors import read_due
 from .simulation import SOLVER_ITERATIONS, Camera, Simulation
@@ -72,6 +73,20 @@ def footprint_radius(robot) -> float:
     return radius
 
 
+def robot_collisions(urdf: str, name: str) -> Dict[str, List[str]]:
+    """A robot's collisions as Gazebo names them (its URDF conversion's names), by link: what the
+    Gazebo API lists and a bumper names; none when the conversion's reader refuses the description."""
+    from .models import gazebo_collision_names  # noqa: PLC0415  (the models' readers)
+
+    out: Dict[str, List[str]] = {}
+    try:
+        for collision in gazebo_collision_names(urdf, name):
+            out.setdefault(collision.link, []).append(collision.name)
+    except SpawnError:  # a description pybullet took and the conversion's reader did not: names unknown
+        return {}
+    return out
+
+
 class Engine:
     """A world: its client, its Simulation, and the requests of the node (:meth:`handle`)."""
 
@@ -86,6 +101,7 @@ class Engine:
         )  # fmt: skip
         self.active: Dict[Tuple[str, int], bool] = {}  # a sensor had readers at its last step
         self.passive: Dict[str, List[int]] = {}  # each robot's joints RobotIO reports, listed once at its spawn
+        self.gazebo = GazeboBodies(self.sim)  # the Gazebo API's side in this world (thorvald_sim.gazebo)
 
     def handle(self, request):
         kind = request[0]
@@ -99,10 +115,17 @@ class Engine:
             except SpawnError as e:
                 return ("refused", str(e))
             self.passive.pop(request[1], None)
+            self.gazebo.forget(request[1])
             return ("deleted",)
         if kind == "reset":
             self.sim.reset()
+            self.gazebo.reset()
             return ("reset",)
+        if kind == "gazebo":
+            return ("answer", self.gazebo.handle(*request[1:]))
+        if kind == "restart_time":
+            self.restart_time()
+            return ("restarted",)
         if kind == "render":
             return ("image", self.sim.render(request[1]))
         raise ValueError(f"unknown request {kind!r}")
@@ -123,12 +146,14 @@ class Engine:
             "sensor_problems": robot.sensor_problems,
             "missing_meshes": robot.missing_meshes,
             "radius": footprint_radius(robot),
+            "entity": self.gazebo.describe(name, robot_collisions(urdf, name)),
         }
         return ("spawned", info)
 
-    def step(self, commands, reads, positions, stamped=None):
+    def step(self, commands, reads, positions, stamped=None, gazebo_states=0):
         """Each robot's command, the step, then what reads asks of each robot at the instant after it
-        (drive states and currents for stamped, the instant as the node's messages carry it)."""
+        (drive states and currents for stamped, the instant as the node's messages carry it), and with
+        states every model's (and link's) state for the Gazebo API's topics."""
         sim = self.sim
         for name, command in commands.items():
             robot = sim.robots[name]
@@ -136,6 +161,7 @@ class Engine:
                 robot.command(*command[1])
             else:
                 robot.hold()
+        self.gazebo.before_step()
         sim.step()
         now = sim.time
         drives_now = now if stamped is None else stamped
@@ -156,7 +182,18 @@ class Engine:
         places = None
         if positions:
             places = {name: robot.world_pose()[0][:2] for name, robot in sim.robots.items()}
-        return ("stepped", sim.solver_cpu, time.process_time(), readings, places)
+        gazebo = self.gazebo.states(gazebo_states) if gazebo_states else None
+        return ("stepped", sim.solver_cpu, time.process_time(), readings, places, gazebo)
+
+    def restart_time(self) -> None:
+        """Simulated time back to zero (Gazebo's reset_simulation): every schedule starts again."""
+        self.sim.steps = 0
+        self.sim.time = 0.0
+        self.gazebo.restart_time()
+        for robot in self.sim.robots.values():
+            for sensor in robot.sensors:
+                sensor.schedule.pause()
+        self.active.clear()
 
     def close(self) -> None:
         from .bullet import pybullet as p  # noqa: PLC0415  (the world's side)
@@ -196,6 +233,7 @@ class RobotProxy:
         self.sensor_problems = info["sensor_problems"]
         self.missing_meshes = info["missing_meshes"]
         self.radius = info["radius"]  # [m] footprint: base_link to the farthest corner of its links' boxes, xy
+        self.entity = info["entity"]  # its links, joints and collisions as the Gazebo API names them
         self.sensors = [SensorProxy(spec, self, k) for k, spec in enumerate(info["sensors"])]
         self.alive = True  # False once its worker died
         self.queued: Optional[tuple] = None  # ("apply", command) or ("hold",) for the next step
@@ -283,6 +321,7 @@ class LocalPhysics:
         self.dt = self.sim.dt
         self.solver_iterations = self.sim.solver_iterations
         self.robots: Dict[str, RobotProxy] = {}
+        self.gazebo_states = None  # the Gazebo API's states after the last step that asked for them
 
     @property
     def time(self) -> float:
@@ -317,15 +356,33 @@ class LocalPhysics:
         return self.sim.render(camera or Camera()), ""
 
     def step(
-        self, reads: Optional[Dict[str, Reads]] = None, positions: bool = False, stamped: Optional[float] = None
+        self,
+        reads: Optional[Dict[str, Reads]] = None,
+        positions: bool = False,
+        stamped: Optional[float] = None,
+        states: int = 0,
     ) -> List[Any]:
         """As WorkerPool.step: the queued commands, the step, what reads asks; no worker dies here."""
         instant = (self.sim.steps + 1) * self.dt if stamped is None else stamped
         robots = list(self.robots.values())
         commands, asked = queued_and_asked(robots, reads)
-        _, _, _, readings, places = self.engine.step(commands, asked, positions, stamped)
+        _, _, _, readings, places, self.gazebo_states = self.engine.step(commands, asked, positions, stamped, states)
         took(robots, instant, asked, readings, places)
         return []
+
+    def ask(self, worker: int, request: tuple):
+        """The Gazebo API's request (op, *args) answered by the world (thorvald_sim.gazebo.bodies)."""
+        return self.engine.gazebo.handle(*request)
+
+    def live_workers(self) -> Tuple[int, ...]:
+        return (0,)
+
+    def placement(self, pose: Pose2D) -> int:
+        """The world a body at pose goes to: the one there is."""
+        return 0
+
+    def restart_time(self) -> None:
+        self.engine.restart_time()
 
     def too_close(self, margin: float = 0.0) -> list:
         """Robots of one client touch each other: none is ever too close to."""

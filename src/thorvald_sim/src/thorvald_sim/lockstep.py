@@ -71,6 +71,14 @@ class Lockstep:
             self.condition.notify_all()
             return joined
 
+    def restart(self) -> None:
+        """Time went back to zero (the Gazebo API's reset_simulation): no robot owes an answer for an
+        instant of the old time; each is awaited again from its next drive states."""
+        with self.condition:
+            for robot in self._robots.values():
+                robot.awaiting = None
+            self.condition.notify_all()
+
     def forget(self, name: str) -> None:
         with self.condition:
             self._robots.pop(name, None)

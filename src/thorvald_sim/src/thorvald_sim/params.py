@@ -44,6 +44,8 @@ The parameters, their defaults and what each means:
 ``~worker_strips``        with physics workers: the x [m] between each two workers' strips (N - 1
                           increasing numbers, a list or a text "9 18"); a robot goes to the worker
                           of its spawn x's strip (none: to the worker with the fewest robots)
+``~gazebo_namespace``     where Gazebo's ROS API is offered (/gazebo; spawn_model's
+                          ``-gazebo_namespace``): docs/coming-from-gazebo.md
 ========================  ================================================================
 
 Pure: no rospy.
@@ -84,6 +86,7 @@ class SimulatorParams:
     lockstep: bool = False
     physics_workers: int = 1  # 1: the node's own pybullet client; N >= 2: N worker processes (thorvald_sim.workers)
     worker_strips: Tuple[float, ...] = ()  # [m] N - 1 increasing x: worker k takes spawn x in its strip
+    gazebo_namespace: str = "/gazebo"  # where Gazebo's ROS API is offered (thorvald_sim.gazebo.api)
 
     @classmethod
     def read(cls, get: Getter) -> "SimulatorParams":
@@ -128,7 +131,21 @@ class SimulatorParams:
             lockstep=bool(get("lockstep", d.lockstep)),
             physics_workers=workers,
             worker_strips=strips,
+            gazebo_namespace=_namespace(get("gazebo_namespace", d.gazebo_namespace)),
         )
+
+
+def _namespace(value: Any) -> str:
+    """~gazebo_namespace: a global ROS name (``/gazebo``), as gazebo_ros's ``-gazebo_namespace`` is."""
+    import rosgraph.names  # noqa: PLC0415  (ROS's name rules; not the ROS runtime)
+
+    text = value if isinstance(value, str) else ""
+    if not text.startswith("/") or not rosgraph.names.is_legal_name(text):
+        raise ParameterError(
+            f"~gazebo_namespace: {value!r}: must be a global ROS name, as /gazebo (a / first, then letters, "
+            "digits, underscores and slashes)"
+        )
+    return text
 
 
 def _number(get: Getter, name: str, default: float, allow_zero: bool = False) -> float:

@@ -68,6 +68,11 @@ class RobotIO:
         elif action == HOLD:
             self.robot.hold()
 
+    def restart_time(self) -> None:
+        """Simulated time went back to zero (the Gazebo API's reset_simulation)."""
+        self.commands.restart_time()
+        self.sensors.restart_time()
+
     def reads(self, drives: bool, currents: bool, odometry: bool, tf_read: bool, now: float) -> Reads:
         """What to read of this robot after the step to now: what is due, and read."""
         return Reads(

@@ -284,6 +284,10 @@ class RobotSensors:
         sensors = [io.sensor for io in self.ios]
         self.publish_readings(now, read_due(sensors, wanted, now, self._schedule, sensors[0].robot.name))
 
+    def restart_time(self) -> None:
+        """Simulated time went back to zero: who reads which sensor is asked again at the next step."""
+        self._checked = -math.inf
+
     def _check(self, now: float) -> None:
         if now - self._checked >= self.CHECK_PERIOD:
             self._checked = now

@@ -20,6 +20,7 @@ from thorvald_msgs.srv import (
 
 from .as_built import SimAsBuilt
 from .errors import SpawnError
+from .gazebo.frames import euler_of
 from .robot import Pose2D
 from .robot_io import RobotIO
 from .simulation import Camera, save_png
@@ -51,8 +52,7 @@ class SimulatorServices:
 
     def srv_reset(self, _req):
         with self.node.lock:
-            self.node.sim.reset()
-        rospy.loginfo("simulator: robots back at their spawn poses")
+            self.node.reset_world()
         return EmptyResponse()
 
     def srv_spawn(self, req):
@@ -74,32 +74,46 @@ class SimulatorServices:
                 rospy.logerr("simulator: refused to spawn %s: %s", req.model_name, e)
                 return SpawnRobotResponse(False, f"{req.model_name}: {e}")
         with self.node.lock:
-            try:
-                robot = self.node.sim.spawn(req.model_name, req.robot_description, pose, as_built)
-            except SpawnError as e:
-                rospy.logerr("simulator: refused to spawn: %s", e)
-                return SpawnRobotResponse(False, str(e))
-            for mesh in robot.missing_meshes:
-                if mesh.uri not in self.missing_meshes_said:
-                    self.missing_meshes_said.add(mesh.uri)
-                    rospy.logwarn(
-                        "simulator: %s: mesh %s not found (%s): link %s drawn from its other geometry",
-                        req.model_name,
-                        mesh.uri,
-                        mesh.reason,
-                        mesh.link,
-                    )
-            self.say_sensors(req.model_name, robot)
-            topic = req.command_topic or robot.description.command_topic
-            # by default a robot with the generator's block (odometry/gazebo's frames), not a passive model:
-            # a post's "odom -> base_link" would be another robot's
-            tf = self.node.default_tf and bool(robot.description.drives) if req.publish_tf < 0 else bool(req.publish_tf)
-            self.node.io[req.model_name] = RobotIO(self.node, robot, req.robot_namespace, topic, tf)
-            if tf:
-                self.node.tf_watch.watch.watch(req.model_name, robot.description.base_frame)
-                self.node.tf_watch.poll()
+            ok, message = self.spawn_robot(
+                req.model_name, req.robot_namespace, req.robot_description, pose,
+                command_topic=req.command_topic, publish_tf=req.publish_tf, as_built=as_built,
+            )  # fmt: skip
+        return SpawnRobotResponse(ok, message)
+
+    def spawn_robot(self, name, namespace, description, pose, *, command_topic="", publish_tf=-1, as_built=None):
+        """A robot into the world with its topics (the caller holds the node's lock): (spawned, what
+        was done or why not)."""
+        if self.node.gazebo.entities.model(name) is not None:
+            message = f"a model named {name!r} exists already"
+            rospy.logerr("simulator: refused to spawn: %s", message)
+            return False, message
+        try:
+            robot = self.node.sim.spawn(name, description, pose, as_built)
+        except SpawnError as e:
+            rospy.logerr("simulator: refused to spawn: %s", e)
+            return False, str(e)
+        for mesh in robot.missing_meshes:
+            if mesh.uri not in self.missing_meshes_said:
+                self.missing_meshes_said.add(mesh.uri)
+                rospy.logwarn(
+                    "simulator: %s: mesh %s not found (%s): link %s drawn from its other geometry",
+                    name,
+                    mesh.uri,
+                    mesh.reason,
+                    mesh.link,
+                )
+        self.say_sensors(name, robot)
+        topic = command_topic or robot.description.command_topic
+        # by default a robot with the generator's block (odometry/gazebo's frames), not a passive model:
+        # a post's "odom -> base_link" would be another robot's
+        tf = self.node.default_tf and bool(robot.description.drives) if publish_tf < 0 else bool(publish_tf)
+        self.node.io[name] = RobotIO(self.node, robot, namespace, topic, tf)
+        if tf:
+            self.node.tf_watch.watch.watch(name, robot.description.base_frame)
+            self.node.tf_watch.poll()
+        self.node.gazebo.robot_spawned(name, robot, ((pose.x, pose.y, pose.z), pose.quaternion))
         kind = f"{len(robot.wheels)} drives following {topic}" if robot.wheels else "passive (no drive block)"
-        message = f"spawned {req.model_name} in {req.robot_namespace or '/'} at ({req.x:g}, {req.y:g}), {kind}"
+        message = f"spawned {name} in {namespace or '/'} at ({pose.x:g}, {pose.y:g}), {kind}"
         if tf:
             d = robot.description
             message += f", {d.odometry_frame} -> {d.base_frame} on /tf from ground truth"
@@ -107,7 +121,7 @@ class SimulatorServices:
             message += f", as built: {as_built.source}"
         message += self.node.sim.placed(robot)
         rospy.loginfo("simulator: %s", message)
-        return SpawnRobotResponse(True, message)
+        return True, message
 
     @staticmethod
     def say_sensors(name, robot):
@@ -131,14 +145,64 @@ class SimulatorServices:
 
     def srv_delete(self, req):
         with self.node.lock:
-            try:
-                self.node.sim.delete(req.model_name)
-            except SpawnError as e:
-                return DeleteRobotResponse(False, str(e))
-            self.node.io.pop(req.model_name).close()
-            self.node.tf_watch.watch.forget(req.model_name)
-            self.node.waits.forget(req.model_name)
-        return DeleteRobotResponse(True, f"deleted {req.model_name}")
+            if req.model_name not in self.node.io:
+                return DeleteRobotResponse(
+                    False, f"no robot named {req.model_name!r}; robots: {', '.join(sorted(self.node.io)) or 'none'}"
+                )
+            ok, message = self.delete_robot(req.model_name)
+        return DeleteRobotResponse(ok, message)
+
+    def delete_robot(self, name):
+        """A robot out of the world with its topics (the caller holds the node's lock)."""
+        try:
+            self.node.sim.delete(name)
+        except SpawnError as e:
+            return False, str(e)
+        self.node.io.pop(name).close()
+        self.node.tf_watch.watch.forget(name)
+        self.node.waits.forget(name)
+        self.node.gazebo.model_deleted(name)
+        return True, f"deleted {name}"
+
+    # ---- the Gazebo API's spawns and deletes (thorvald_sim.gazebo.api) ----------------------------
+    def spawn_any(self, name, xml, kind, namespace, pose):
+        """spawn_urdf_model / spawn_sdf_model (the caller holds the lock; pose in the world): a
+        Thorvald robot (a URDF with the generator's drive block) as ~spawn_robot spawns it, any other
+        model as a model of the API (thorvald_sim.models)."""
+        from gazebo_msgs.srv import SpawnModelResponse  # noqa: PLC0415  (the Gazebo API's messages)
+
+        from .description import is_thorvald_robot  # noqa: PLC0415
+        from .spawn_names import model_name_problem, namespace_problem  # noqa: PLC0415 (the spawn's own rules)
+
+        problem = model_name_problem(name) or namespace_problem(namespace)
+        if problem:
+            return SpawnModelResponse(False, f"SpawnModel: Failure - {problem}")
+        (x, y, z), q = pose
+        if kind == "urdf" and is_thorvald_robot(xml):
+            roll, pitch, yaw = euler_of(q)
+            if abs(roll) > 1e-6 or abs(pitch) > 1e-6:
+                rospy.logwarn(
+                    "simulator: %s: a robot spawns upright: roll %.3f and pitch %.3f rad left out", name, roll, pitch
+                )
+            ok, message = self.spawn_robot(name, namespace, xml, Pose2D(x, y, z, yaw))
+            return SpawnModelResponse(
+                ok, "SpawnModel: Successfully spawned entity" if ok else f"SpawnModel: Failure - {message}"
+            )
+        try:
+            message = self.node.gazebo.add_model(name, xml, kind, namespace, pose)
+        except SpawnError as e:
+            rospy.logerr("simulator: refused to spawn: %s", e)
+            return SpawnModelResponse(False, f"SpawnModel: Failure - {e}")
+        rospy.loginfo("simulator: %s", message)
+        return SpawnModelResponse(True, "SpawnModel: Successfully spawned entity")
+
+    def delete_any(self, model):
+        """delete_model (the caller holds the lock): (deleted, why not)."""
+        if model.name in self.node.io:
+            return self.delete_robot(model.name)
+        self.node.gazebo.remove_model(model)
+        rospy.loginfo("simulator: deleted model %s", model.name)
+        return True, ""
 
     def srv_snapshot(self, req):
         camera = Camera()

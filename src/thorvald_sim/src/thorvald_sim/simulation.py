@@ -78,6 +78,7 @@ class Simulation:
             fixedTimeStep=self.dt, numSolverIterations=solver_iterations, physicsClientId=client
         )
         self.scene = build_scene(client, world)
+        self.gravity = (0.0, 0.0, -world.gravity)  # [m/s^2] as the scene set it (the Gazebo API may change it)
         self.robots: Dict[str, SimRobot] = {}
         self.time = 0.0  # [s] simulated
         self.steps = 0
@@ -135,8 +136,20 @@ class Simulation:
             gravity=self.world.gravity,
             datum=description.datum or self.datum,
         )
+        if self.gravity != (0.0, 0.0, -self.world.gravity):
+            for sensor in robot.sensors:
+                sensor.world_gravity(self.gravity)
         self.robots[name] = robot
         return robot
+
+    def set_gravity(self, gravity: Tuple[float, float, float]) -> None:
+        """The world's gravity [m/s^2, world axes] from now on (the Gazebo API's set_physics_properties),
+        for the physics and every sensor that reads it."""
+        p.setGravity(*gravity, physicsClientId=self.client)
+        self.gravity = tuple(float(v) for v in gravity)
+        for robot in self.robots.values():
+            for sensor in robot.sensors:
+                sensor.world_gravity(self.gravity)
 
     def delete(self, name: str) -> None:
         robot = self.robots.pop(name, None)

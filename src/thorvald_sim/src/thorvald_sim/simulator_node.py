@@ -40,6 +40,7 @@ from thorvald_model.datum import load_datum
 from .bullet import pybullet as p
 from .engine import LocalPhysics, WorldSettings
 from .errors import ParameterError
+from .gazebo.api import GazeboApi
 from .lockstep import Lockstep
 from .pacing import FollowerWait, Pacer
 from .params import SimulatorParams
@@ -92,6 +93,7 @@ class SimulatorNode:
         self.tf_watch = TfWatcher(rospy.get_name(), self.io)  # other publishers of a robot's odom -> base_link
         self.diagnostics = NonBlockingPublisher("/diagnostics", DiagnosticArray)
         self.meter = PerformanceMeter(1.0 / params.diagnostics_rate) if params.diagnostics_rate else None
+        self.gazebo = GazeboApi(self, params.gazebo_namespace)  # Gazebo's /gazebo services and topics
         self.services = SimulatorServices(self)
         self.publish_clock()
         rospy.loginfo(
@@ -191,7 +193,8 @@ class SimulatorNode:
         reads = {io.robot.name: io.reads(drives, currents, odometry, tf_read, now) for io in live}
         stamp = rospy.Time.from_sec(now)
         # drive states and currents are read at the stamp's instant (whole nanoseconds), as they are published
-        for death in self.sim.step(reads, positions=odometry, stamped=stamp.to_sec()):
+        states = self.gazebo.wanted()
+        for death in self.sim.step(reads, positions=odometry, stamped=stamp.to_sec(), states=states):
             self.worker_died(death)
         live = [io for io in live if io.alive]
         if drives or currents:
@@ -207,16 +210,33 @@ class SimulatorNode:
             self.check_proximity()
         for io in live:
             io.sensors.publish_readings(now, io.robot.sensor_results)
+        self.gazebo.publish(self.sim.gazebo_states)
         return ticked
+
+    def reset_world(self) -> None:
+        """Every model back where it was spawned, at rest (~reset, /gazebo/reset_world); time goes on."""
+        self.sim.reset()
+        rospy.loginfo("simulator: models back at their spawn poses")
+
+    def restart_time(self) -> None:
+        """Simulated time back to zero (/gazebo/reset_simulation): /clock says 0 and everything periodic
+        starts again from there; nodes on /use_sim_time see time jump back, as with Gazebo."""
+        self.sim.restart_time()
+        for grid in (self.clock, self.odometry, self.drives, self.currents):
+            grid.pause()
+        self.pacer.paused()
+        self.waits.restart()
+        for io in self.io.values():
+            io.restart_time()
+        self.publish_clock()
+        rospy.loginfo("simulator: simulated time back to 0")
 
     def worker_died(self, death) -> None:
         """A physics worker died: said once with its robots, which go silent and leave lockstep."""
         rospy.logerr(
             "simulator: %s at %.3f s: its robots' topics go silent (delete them with ~delete_robot); "
-            "the other workers' robots go on",
-            death,
-            self.sim.time,
-        )
+            "the other workers' robots go on", death, self.sim.time,
+        )  # fmt: skip
         for name in death.robots:
             io = self.io.get(name)
             if io is not None:
@@ -268,14 +288,11 @@ def main():
     rospy.init_node("simulator")
     try:
         node = SimulatorNode()
-    except (ConfigError, ParameterError) as e:
+    except (ConfigError, ParameterError, WorkerError) as e:
         rospy.logfatal("simulator: refusing to start: %s", e)
         sys.exit(EXIT_REFUSED)
     except p.error as e:
         rospy.logfatal("simulator: refusing to start: pybullet: %s", e)
-        sys.exit(EXIT_REFUSED)
-    except WorkerError as e:
-        rospy.logfatal("simulator: refusing to start: %s", e)
         sys.exit(EXIT_REFUSED)
     try:
         node.spin()

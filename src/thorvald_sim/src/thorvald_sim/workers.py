@@ -163,6 +163,7 @@ class WorkerPool:
         self.time = 0.0  # [s] simulated
         self.steps = 0
         self.robots: Dict[str, RobotProxy] = {}
+        self.gazebo_states = None  # the Gazebo API's states after the last step that asked for them
         self.deaths: List[WorkerDeath] = []  # every worker that died, in order
         self.died_at: List[Tuple[WorkerDeath, float]] = []  # and the simulated time [s] it died at
         self._unreported: List[WorkerDeath] = []  # died since the last step's report
@@ -335,7 +336,11 @@ class WorkerPool:
         raise WorkerError("every physics worker died: nothing to render")
 
     def step(
-        self, reads: Optional[Dict[str, Reads]] = None, positions: bool = False, stamped: Optional[float] = None
+        self,
+        reads: Optional[Dict[str, Reads]] = None,
+        positions: bool = False,
+        stamped: Optional[float] = None,
+        states: int = 0,
     ) -> List[WorkerDeath]:
         """One physics step of dt on every live worker at once: each robot's queued command, then the
         step, then what reads asks of each robot (None: EVERYTHING of every robot; a robot left out:
@@ -350,7 +355,7 @@ class WorkerPool:
             if not w.alive:
                 continue
             commands, asked = queued_and_asked([self.robots[name] for name in w.robots], reads)
-            if self._send(w, ("step", commands, asked, positions, stamped)):
+            if self._send(w, ("step", commands, asked, positions, stamped, states)):
                 sent.append((w, asked))
         pending = {w.conn: (w, asked) for w, asked in sent}
         deadline = time.monotonic() + self.timeout
@@ -377,8 +382,31 @@ class WorkerPool:
         return deaths
 
     def _took(self, w: _Worker, instant: float, asked: Dict[str, Reads], reply) -> None:
-        _, w.solver_cpu, w.cpu, readings, places = reply
+        _, w.solver_cpu, w.cpu, readings, places, gazebo = reply
         took([self.robots[name] for name in w.robots], instant, asked, readings, places)
+        if gazebo is not None and self.gazebo_states is not None:
+            self.gazebo_states[0].update(gazebo[0])
+            self.gazebo_states[1].update(gazebo[1])
+
+    # ---- the Gazebo API's requests (thorvald_sim.gazebo) ------------------------------------------
+    def ask(self, worker: int, request: tuple):
+        """The Gazebo API's request (op, *args) answered by that worker's world; WorkerError when it is dead."""
+        w = self.workers[worker]
+        reply = self._call(w, ("gazebo", *request)) if w.alive else None
+        if reply is None:
+            raise WorkerError(f"physics worker {worker} (pid {w.pid}) is dead")
+        return reply[1]
+
+    def live_workers(self) -> Tuple[int, ...]:
+        return tuple(w.index for w in self.workers if w.alive)
+
+    def restart_time(self) -> None:
+        """Simulated time back to zero in every live worker (Gazebo's reset_simulation)."""
+        sent = [w for w in self.workers if w.alive and self._send(w, ("restart_time",))]
+        for w in sent:
+            self._receive(w, REQUEST_TIMEOUT)
+        self.steps = 0
+        self.time = 0.0
 
     def too_close(self, margin: float = PROXIMITY_MARGIN) -> List[TooClose]:
         """The pairs of live robots on different workers whose last positions are closer than their

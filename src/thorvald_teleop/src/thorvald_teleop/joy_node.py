@@ -62,7 +62,7 @@ class JoyNode:
         self.last_diag = time.monotonic()
         self.stopping = threading.Event()
         rospy.on_shutdown(self.stopping.set)
-        self.timer = rospy.Timer(rospy.Duration(1.0), self.publish_diagnostics)
+        self.timer = rospy.Timer(rospy.Duration(1.0), self.publish_diagnostics, reset=True)
         rospy.loginfo(
             "joy_node: %s on %s, deadzone %.3f, autorepeat %.1f Hz, coalesce %.3f s",
             self.dev,

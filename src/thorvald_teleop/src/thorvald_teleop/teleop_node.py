@@ -35,7 +35,7 @@ class TeleopNode:
         self.priority_pub.publish(Bool(False))
         self.home = rospy.ServiceProxy("home_steering", Trigger)
         rospy.Subscriber("joy", Joy, self.on_joy, queue_size=1, tcp_nodelay=True)
-        rospy.Timer(rospy.Duration(0.05), self.on_timer)
+        rospy.Timer(rospy.Duration(0.05), self.on_timer, reset=True)
         c = self.config
         rospy.loginfo(
             "teleop_node: deadman %d, turbo %d, priority toggle %d, home steering %d; linear %s x %s, angular %s x %s",

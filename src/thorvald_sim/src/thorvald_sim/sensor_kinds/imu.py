@@ -71,14 +71,18 @@ class ImuReading:
 
 class Imu(Sensor):
     """Reads the mount's orientation in the world (its ``rpyOffset`` applied), its angular velocity and
-    its proper acceleration (the mean acceleration since the last reading, minus gravity: +9.81 m/s^2
-    up at rest), in the sensor's axes; gaussianNoise on every component."""
+    its proper acceleration (the mean acceleration since the last reading, minus the world's gravity:
+    +9.81 m/s^2 up at rest, and whatever set_physics_properties made it), in the sensor's axes;
+    gaussianNoise on every component."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        self.gravity = self.context.gravity
+        self.gravity = np.array([0.0, 0.0, -self.context.gravity])  # [m/s^2] world axes
         self.last: Optional[Tuple[float, np.ndarray]] = None  # (time, velocity) of the last reading
         self.offset_rotation = p.getQuaternionFromEuler(self.spec.config.rpy_offset)
+
+    def world_gravity(self, gravity) -> None:
+        self.gravity = np.array(gravity, dtype=float)
 
     def read(self, now: float) -> ImuReading:
         c: ImuConfig = self.spec.config
@@ -88,7 +92,7 @@ class Imu(Sensor):
         else:
             a = np.zeros(3)
         self.last = (now, v)
-        proper = a + np.array([0.0, 0.0, self.gravity])
+        proper = a - self.gravity
         acc = unrotate(quat, proper)
         gyro = unrotate(quat, w)
         _, orientation = p.multiplyTransforms((0, 0, 0), self.offset_rotation, (0, 0, 0), quat)

@@ -146,6 +146,10 @@ class Sensor:
     def client(self) -> int:
         return self.robot.client
 
+    def world_gravity(self, gravity: Tuple[float, float, float]) -> None:
+        """The world's gravity [m/s^2] (a vector, world axes) changed, by the Gazebo API's
+        set_physics_properties: a model that reads it follows (the IMU); the others ignore it."""
+
     def due(self, now: float) -> bool:
         """Whether a reading is due at now; if so, the noise is that instant's."""
         if not self.schedule.due(now):
