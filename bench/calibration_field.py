@@ -11,8 +11,8 @@ For each seed, as a user types it:
    in effect (the radii balanced, the steering's toe searched, the radii balanced again), the fit again
    with each radius and offset moved to the balance's along what the drive did not determine, the
    radii's common factor from straight legs with that in effect
-   (``scaled_calibration.yaml``), and odometry's yaw-rate multiplier from U turns of the working radius
-   with that in effect (``calibration.yaml``);
+   (``scaled_calibration.yaml``), and odometry's heading model (its yaw-rate multiplier, yaw per metre
+   crabbing, the wheels' weights) from the heading manoeuvre with that in effect (``calibration.yaml``);
 2. ``odometry_report --manoeuvre field`` (five 15 m rows and headland U turns, 84 m) uncalibrated,
    with ground truth's calibration alone, with the calibration before the turns, with the calibration,
    and with the as-built robot's own radii and offsets in effect (what no per-drive calibration can
@@ -105,7 +105,8 @@ def main() -> int:
                 ),
             }
             tyres = result.get("tyres", {})
-            rows.append((seed, runs, tyres, result["turns"]["yaw_rate_multiplier"]["value"]))
+            model = result.get("heading", {}).get("yaw_rate_multiplier", {"value": float("nan")})
+            rows.append((seed, runs, tyres, model["value"]))
             for against, f in runs["calibrated"].items():
                 if abs(f["distance_error_percent"]) > DISTANCE or f["end_point_m"] > END:
                     missed.append(f"field:{seed} {against}: {cell(f)}")

@@ -50,7 +50,10 @@ from .calibration import (
     set_drive_params_command,
 )
 from .calibration.calibration_file import changes_yaml, read_calibration
+from .calibration.heading import WINDOW as HEADING_WINDOW
+from .calibration.heading import HeadingFit, describe, heading_fit
 from .calibration.observable import FAR, along_undetermined
+from .calibration.odometry_error import imu_bias
 from .calibration.turns import TurnFit, turn_fit
 from .conversions import quaternion_yaw
 from .errors import CalibrationError, ThorvaldBaseError
@@ -148,7 +151,13 @@ def parse_args(argv: Optional[List[str]]):
         prog="calibrate_odometry",
         description="Each drive's rolling radius and steering offset from a recorded drive with ground truth.",
     )
-    parser.add_argument("bag", help="the recorded drive: base_state and ground truth")
+    parser.add_argument(
+        "bags",
+        nargs="+",
+        metavar="BAG",
+        help="the recorded drive: base_state and ground truth (--fit heading: one or more, each recorded with "
+        "--calibration in effect)",
+    )
     parser.add_argument("--robot-model", required=True, help="the robot file base_driver ran on")
     parser.add_argument("--calibration", default="", help="the calibration file base_driver ran with, if any")
     parser.add_argument(
@@ -169,7 +178,7 @@ def parse_args(argv: Optional[List[str]]):
     )
     parser.add_argument(
         "--fit",
-        choices=("drives", "odometry", "scale", "straight", "turns"),
+        choices=("drives", "odometry", "scale", "straight", "turns", "heading"),
         default="drives",
         help="drives: each drive's radius and offset from its own wheel's motion (the default); odometry: only "
         "the combinations the drive determines through the odometry, the rest kept at the values in effect "
@@ -177,7 +186,9 @@ def parse_args(argv: Optional[List[str]]):
         "standstills (the straight manoeuvre, driven with the calibration in effect); straight: the same legs' "
         "common factor and odometry's yaw per metre, from the legs' heading; turns: only odometry's "
         "yaw-rate multiplier, from U turns of the working radius (the turns manoeuvre, driven with the "
-        "calibration in effect)",
+        "calibration in effect); heading: odometry's heading model (yaw-rate multiplier, yaw per metre along x "
+        "and y, each wheel's weight in the yaw rate) from drives of every motion (the heading manoeuvre, driven "
+        "with the calibration in effect)",
     )
     parser.add_argument(
         "--balance",
@@ -187,13 +198,22 @@ def parse_args(argv: Optional[List[str]]):
         "currents): the radii move to it along the combinations the drive does not determine (the simulator's "
         "ground truth), or take it with ground truth's common factor (GNSS)",
     )
+    parser.add_argument(
+        "--keep-yaw-per-metre",
+        action="store_true",
+        help="--fit heading: keep the calibration in effect's yaw per metre along x (straight legs at working "
+        "speed told it, --fit straight) and fit the rest",
+    )
     parser.add_argument("--json", action="store_true", help="print the results as one JSON document")
     return parser.parse_args(argv)
 
 
 def main(argv: Optional[List[str]] = None) -> int:
     args = parse_args(argv)
+    args.bag = args.bags[0]
     try:
+        if len(args.bags) > 1 and args.fit != "heading":
+            raise CalibrationError(f"--fit {args.fit} takes one bag, not {len(args.bags)} (--fit heading, several)")
         return run(args)
     except (ConfigError, ThorvaldBaseError) as e:
         print(f"calibrate_odometry: {e}", file=sys.stderr)
@@ -210,10 +230,13 @@ def run(args) -> int:
         earlier, odometry = list(values.changes), values.odometry
         for index, key, value in earlier:
             in_effect = in_effect.with_drive_param(index, key, value)
-    if args.fit in ("scale", "straight", "turns") and args.balance:
+    if args.fit in ("scale", "straight", "turns", "heading") and args.balance:
         raise CalibrationError(
             f"--balance goes with --fit drives or odometry: --fit {args.fit} keeps every radius's share"
         )
+    if args.fit == "heading":
+        drives = [read_bag(bag, len(robot.drives), args.ground_truth, args.antenna) for bag in args.bags]
+        return run_heading(args, in_effect, drives, earlier=earlier, odometry=odometry)
     recording, truth, said, namespace = read_bag(args.bag, len(robot.drives), args.ground_truth, args.antenna)
     if args.fit == "turns":
         return run_turns(args, in_effect, recording, truth, said=said, earlier=earlier, odometry=odometry)
@@ -237,7 +260,7 @@ def run(args) -> int:
     if args.balance:
         calibration = with_balance(calibration, observable, list(read_calibration(args.balance, robot).changes), robot)
     calibrated = calibration.calibrated(in_effect)
-    bias = calibration.heading_bias[0] if calibration.heading_bias else 0.0
+    bias = calibration.heading_bias[0] if calibration.heading_bias else _bias(in_effect, recording, truth, correction)
     before = odometry_error(in_effect, recording, truth, bias, correction=correction)
     after = odometry_error(
         calibrated, as_read_with(recording, in_effect, calibrated), truth, bias, correction=odometry or NO_CORRECTION
@@ -312,9 +335,9 @@ def default_out(args) -> str:
 def run_turns(args, in_effect, recording, truth, *, said: str, earlier, odometry) -> int:
     """--fit turns: the yaw-rate multiplier from the drive's turns, every drive value kept."""
     fit = turn_fit(in_effect, recording, truth, odometry or NO_CORRECTION)
-    # as --fit scale: GNSS's end point taken with the IMU's yaw as it reads (its bias is not estimated here)
-    before = odometry_error(in_effect, recording, truth, correction=fit.in_effect)
-    after = odometry_error(in_effect, recording, truth, correction=fit.correction)
+    bias = _bias(in_effect, recording, truth, fit.in_effect)
+    before = odometry_error(in_effect, recording, truth, bias, correction=fit.in_effect)
+    after = odometry_error(in_effect, recording, truth, bias, correction=fit.correction)
     out = args.out or default_out(args)
     header = header_lines(args, out, said)
     header += f"\nthe yaw-rate multiplier from {len(fit.turns)} turns"
@@ -326,6 +349,83 @@ def run_turns(args, in_effect, recording, truth, *, said: str, earlier, odometry
     else:
         print_turns(fit, said, (before, after), path=out, kept=bool(earlier))
     return 0
+
+
+def _bias(config, recording, truth, correction) -> float:
+    """[rad] the IMU's yaw bias an end-point figure against GNSS needs (0 with the simulator's ground
+    truth): from the fixes and odometry's translation, for fits that do not estimate it."""
+    return imu_bias(config, recording, truth, correction=correction) if isinstance(truth, GnssTruth) else 0.0
+
+
+def run_heading(args, in_effect, drives, *, earlier, odometry) -> int:
+    """--fit heading: odometry's heading model from one or more drives, every drive value kept."""
+    drives_ = [(recording, truth) for recording, truth, _, _ in drives]
+    fit = heading_fit(in_effect, drives_, odometry or NO_CORRECTION, keep_yaw_per_metre=args.keep_yaw_per_metre)
+    errors = []
+    for bag, (recording, truth, _, _) in zip(args.bags, drives):
+        bias = _bias(in_effect, recording, truth, fit.correction)
+        before = odometry_error(in_effect, recording, truth, bias, correction=fit.in_effect)
+        after = odometry_error(in_effect, recording, truth, bias, correction=fit.correction)
+        errors.append((bag, before, after))
+    said = drives[0][2]
+    out = args.out or default_out(args)
+    header = header_lines(args, out, said)
+    header += f"\nodometry's heading model from {fit.windows} windows of {HEADING_WINDOW:g} s"
+    if len(args.bags) > 1:
+        header += " of " + ", ".join(os.path.abspath(bag) for bag in args.bags)
+    if earlier:
+        header += f"; the drives' values kept from {args.calibration}"
+    write_text(out, changes_yaml([], header, extra=earlier, odometry=fit.correction))
+    if args.json:
+        print(json.dumps(heading_json(fit, said, errors, out), indent=2))
+        return 0
+    print(f"ground truth: {said}")
+    for line in describe(fit):
+        print(line)
+    for bag, before, after in errors:
+        print(
+            f"odometry against ground truth on {os.path.basename(bag)}: before {before.distance_error_percent:+.3f} % "
+            f"of {before.truth_distance_m:.2f} m, end point {before.end_point_m:.3f} m; after "
+            f"{after.distance_error_percent:+.3f} %, end point {after.end_point_m:.3f} m"
+        )
+    print(f"wrote {out}" + (" (with the drives' values of the calibration in effect)" if earlier else ""))
+    print("base_driver applies it at start (~calibration); set_drive_params does not change odometry's correction")
+    return 0
+
+
+def heading_json(fit: HeadingFit, said: str, errors, path: str) -> dict:
+    c = fit.correction
+    names = ("yaw_rate_multiplier", "yaw_per_metre", "yaw_per_metre_sideways")
+    values = (c.yaw_rate_multiplier, c.yaw_per_metre, c.yaw_per_metre_sideways)
+    in_effect = (fit.in_effect.yaw_rate_multiplier, fit.in_effect.yaw_per_metre, fit.in_effect.yaw_per_metre_sideways)
+    out = {"fit": "heading", "ground_truth_source": said, "windows": fit.windows}
+    for name, value, sd, excited, was in zip(names, values, fit.sd, fit.excited, in_effect):
+        out[name] = {"value": value, "sd": _number(sd), "excited": excited, "in_effect": was}
+    out["wheel_weights"] = {
+        "value": list(c.wheel_weights),
+        "told": fit.weights_told,
+        "said": fit.weights_said,
+        "in_effect": list(fit.in_effect.wheel_weights),
+    }
+    out["yaw_per_metre"]["kept"] = fit.kept_yaw_per_metre
+    out["heading_rms_deg"] = {"before": math.degrees(fit.rms_before), "after": math.degrees(fit.rms_after)}
+    out["motions"] = [
+        {
+            "motion": m.motion,
+            "windows": m.windows,
+            "seconds": m.seconds,
+            "turned_deg": math.degrees(m.turned),
+            "before_deg": math.degrees(m.before),
+            "after_deg": math.degrees(m.after),
+            "rms_before_deg": math.degrees(m.rms_before),
+            "rms_after_deg": math.degrees(m.rms_after),
+        }
+        for m in fit.motions
+    ]
+    out["drives"] = [{"bag": os.path.abspath(bag), "before": _errors(b), "after": _errors(a)} for bag, b, a in errors]
+    out["before"], out["after"] = _errors(errors[0][1]), _errors(errors[0][2])
+    out["calibration_file"] = path
+    return out
 
 
 def header_lines(args, path: str, said: str) -> str:

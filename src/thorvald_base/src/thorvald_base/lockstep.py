@@ -78,7 +78,9 @@ def apply_calibration(core: BaseDriverCore, path: str) -> CalibrationValues:
 def calibration_said(values: CalibrationValues) -> str:
     """What a calibration file set, in a few words (base_driver logs it)."""
     said = [f"drive{i} {key} {value:g}" for i, key, value in values.changes]
-    for key in ("yaw_rate_multiplier", "yaw_per_metre"):
+    for key in ("yaw_rate_multiplier", "yaw_per_metre", "yaw_per_metre_sideways"):
         if getattr(values, key) is not None:
             said.append(f"odometry {key} {getattr(values, key):g}")
+    if values.wheel_weights is not None:
+        said.append("odometry wheel_weights " + " ".join(f"{w:.3g}" for w in values.wheel_weights))
     return ", ".join(said) or "nothing to change"

@@ -38,7 +38,7 @@ def plan_for(config: RobotConfig) -> Tuple[str, List[Segment]]:
     return "a stadium twice: straights and half circles about its axle line", _stadium(axle)
 
 
-MANOEUVRES = ("verification", "calibration", "field", "balance", "straight", "turns")
+MANOEUVRES = ("verification", "calibration", "field", "balance", "straight", "turns", "heading")
 ROWS, ROW_LENGTH, ROW_SPACING = 5, 15.0, 1.5  # the field route: every second row of 0.75 m rows
 TURN_SIGNS = (1.0, 1.0, -1.0, -1.0, 1.0, 1.0, -1.0, -1.0)  # the turns manoeuvre's U turns: two loops each way
 SIDE = 4.0  # [m] of the calibration drive's square (UMBmark's 4 m)
@@ -74,7 +74,7 @@ def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str,
             f"a field route: {ROWS} rows of {ROW_LENGTH:g} m, {ROW_SPACING:g} m apart, joined by headland U turns",
             _field_route(config),
         )
-    if name not in ("calibration", "balance", "straight", "turns"):
+    if name not in ("calibration", "balance", "straight", "turns", "heading"):
         raise ValueError(f"manoeuvre must be one of {', '.join(MANOEUVRES)}, not {name!r}")
     if not (side > 0.0 and math.isfinite(side)):
         raise ValueError(f"side must be a positive length [m], not {side!r}")
@@ -94,6 +94,13 @@ def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str,
             f"turns: {len(TURN_SIGNS)} headland U turns of the field route's radius ({ROW_SPACING / 2:g} m), "
             f"twice left and twice right in turn, joined by {side:g} m rows",
             _turns(config, side),
+        )
+    if name == "heading":
+        calibration, straight, turns = (plan_named(part, config, side) for part in ("calibration", "straight", "turns"))
+        return (
+            f"heading: every motion the robot makes, one after another: the {calibration[0]}; the {straight[0]}; "
+            f"the {turns[0]}",
+            calibration[1] + straight[1] + turns[1],
         )
     if name == "straight":
         return (

@@ -290,6 +290,52 @@ def test_fit_turns_takes_the_yaw_rate_multiplier_from_the_turns_over_the_calibra
         assert status == 2 and err.count("\n") == 1 and message in err, err
 
 
+@pytest.mark.slow  # fits and replays of whole synthetic drives
+def test_fit_heading_takes_odometrys_heading_model_from_several_drives_over_the_calibration_in_effect(
+    tmp_path, capsys, std
+):
+    from calibration_test_helpers import with_turn_slip  # noqa: PLC0415
+
+    from thorvald_base.calibration.calibration_file import read_calibration  # noqa: PLC0415
+    from thorvald_base.verification import plan_named  # noqa: PLC0415
+
+    earlier = tmp_path / "earlier.yaml"
+    earlier.write_text("motor_drives:\n  drive1: {r_wheel: 0.205}\nodometry: {yaw_per_metre: 0.0004}\n")
+    in_effect = std.with_drive_param(1, "r_wheel", 0.205)
+    radii = [d.r_wheel for d in in_effect.drives]
+    bags = []
+    for name in ("calibration", "turns"):  # two drives with the calibration in effect, turning 0.6 % more
+        plan = [(s.duration, s.twist) for s in plan_named(name, std, side=3.0)[1]]
+        drive = with_turn_slip(synthetic_drive(in_effect, plan, radii, [0.0] * 4), left=1.006, right=1.006)
+        bags.append(write_bag(tmp_path / f"{name}.bag", drive, gnss=True))
+    common = ["--robot-model", STD, "--calibration", earlier, "--fit", "heading", "--keep-yaw-per-metre"]
+    status, out, err = run(capsys, *bags, *common)
+    assert status == 0, err
+    assert "heading error (ground truth less odometry) by motion, over" in out
+    assert "  m (yaw-rate multiplier)      1.00600" in out
+    assert "  b (yaw per metre along x)    +0.000400 rad/m (kept: the straight legs') (was 0.0004)" in out
+    assert "wheel weights (mean 1)       all alike (kept: not told apart: the wheels never disagreed" in out
+    assert out.count("odometry against ground truth on ") == 2
+    values = read_calibration(str(tmp_path / "calibration.yaml"), std)
+    assert values.changes == ((1, "r_wheel", 0.205),)  # the drives' values kept
+    # with_turn_slip's truth turns each twist's wz 1.006 times as fast, translation kept: exactly the model
+    assert values.yaw_rate_multiplier == pytest.approx(1.006, abs=1e-6) and values.yaw_per_metre == 0.0004
+    # from the IMU's yaw, as JSON, b fitted too (the slip is all m's, b 0). The IMU's yaw is averaged over
+    # 0.05 s either side of each window's ends, which is exact where the heading changes linearly and off
+    # by up to a quarter of that times the rate's jump where a synthetic drive steps from one twist to
+    # the next (a real drive ramps): m and b to a few parts in a thousand
+    status, out, err = run(capsys, *bags, *common[:-1], "--ground-truth", "gnss", "--json")
+    assert status == 0, err
+    result = json.loads(out)
+    assert result["fit"] == "heading" and len(result["drives"]) == 2 and not result["wheel_weights"]["told"]
+    assert result["yaw_rate_multiplier"]["value"] == pytest.approx(1.006, abs=3e-3)
+    assert result["yaw_per_metre"]["value"] == pytest.approx(0.0, abs=1e-3) and not result["yaw_per_metre"]["kept"]
+    assert result["after"]["end_point_m"] < result["before"]["end_point_m"]
+    # another fit takes one bag
+    status, out, err = run(capsys, *bags, "--robot-model", STD, "--fit", "turns")
+    assert status == 2 and err.count("\n") == 1 and "--fit turns takes one bag, not 2" in err, err
+
+
 BAD_BAGS = [
     (lambda p, d: p.write_text("not a bag") or str(p), [], "cannot read the bag"),
     (lambda p, d: str(p) + ".missing", [], "cannot read the bag"),

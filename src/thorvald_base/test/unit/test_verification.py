@@ -133,7 +133,8 @@ def _truthful(drive):
 def test_a_manoeuvre_of_another_name_or_a_bad_side_is_refused():
     config = four_ws()
     with pytest.raises(
-        ValueError, match="one of verification, calibration, field, balance, straight, turns, not 'umbmark'"
+        ValueError,
+        match="one of verification, calibration, field, balance, straight, turns, heading, not 'umbmark'",
     ):
         plan_named("umbmark", config)
     with pytest.raises(ValueError, match="side must be a positive length"):

@@ -22,16 +22,19 @@ balanced_calibration.yaml); and the straight manoeuvre, driven at working speed 
 gives the radii's common factor and odometry's yaw per metre, the turn it reads on a straight line that
 the frame does not make (``calibrate_odometry --fit straight``): scaled_calibration.yaml.
 
-Last, unless ``--no-turns``, the turns manoeuvre (the field route's headland U turns, twice each way,
-twice) is driven with all that in effect, and odometry's yaw-rate multiplier fitted to its turns
-(``calibrate_odometry --fit turns``): calibration.yaml, what base_driver loads. The tyres slip in a
-turn, and no radius or offset makes the wheels' geometry read a turn as the body turns.
+Last, unless ``--no-heading``, the heading manoeuvre (the calibration manoeuvre's straight runs, crab
+legs, spins, squares and circles, the straight legs, and the field route's headland U turns) is driven
+with all that in effect, and odometry's heading model fitted to it (``calibrate_odometry --fit
+heading``: the yaw-rate multiplier, yaw per metre along x and y, and each wheel's weight in the yaw
+rate): calibration.yaml, what base_driver loads. The tyres slip in a turn, a frame crabbing can turn
+where its wheels say straight, and while the wheels re-steer they disagree and the frame turns as the
+wheels that carry it say; no radius or offset makes the wheels' geometry read that.
 
 A balance that the legs cannot support stops (balance_wheels says why: wheels whose torques do not
 follow their radii, a radius beyond what a tyre's pressure and wear give, a fight that did not
 shrink, a radius the robot file's rules refuse): the calibration from ground truth then stands, a
-warning says so, and the straight legs and the turns follow with it; ``--require-balance`` exits 3
-there instead.
+warning says so, and the straight legs and the heading drive follow with it; ``--require-balance``
+exits 3 there instead.
 
 Exit status 0 with the calibration; 2 with the reason on stderr (a robot file's problems, one per
 line; otherwise one line) and no traceback; 3 (``--require-balance``) when the balance stopped.
@@ -67,8 +70,8 @@ BALANCED = "balanced.yaml"  # balance_wheels': the radii where the wheels do not
 BALANCE_JSON = "balance.json"
 BALANCED_FIT = "balanced_calibration.yaml"  # the calibration drive's fit with the balance, before the straight legs
 STRAIGHT_BAG = "straight.bag"
-SCALED = "scaled_calibration.yaml"  # the straight legs' common factor on the balanced fit, before the turns
-TURNS_BAG = "turns.bag"
+SCALED = "scaled_calibration.yaml"  # the straight legs' common factor on the balanced fit, before the heading
+HEADING_BAG = "heading.bag"
 NO_BALANCE = 3  # the exit status with --require-balance when the balance stopped (balance_wheels' own)
 
 
@@ -103,8 +106,9 @@ def parser() -> argparse.ArgumentParser:
         "truth stands, with a warning, and the drive goes on",
     )  # fmt: skip
     p.add_argument(
-        "--no-turns", dest="turns", action="store_false",
-        help="leave out the last drive, the U turns that fit odometry's yaw-rate multiplier",
+        "--no-heading", "--no-turns", dest="heading", action="store_false",
+        help="leave out the last drive, the heading manoeuvre that fits odometry's heading model (the yaw-rate "
+        "multiplier, yaw per metre along x and y, the wheels' weights)",
     )  # fmt: skip
     p.add_argument("--out", metavar="DIR", default="calibration_drive", help="the bag's and the calibration's folder")
     p.add_argument("--json", action="store_true", help="print calibrate_odometry's results as JSON")
@@ -149,7 +153,7 @@ def run(args) -> int:
     for stale in (os.path.join(out, name) for name in (CALIBRATION, ODOMETRY, SCALED)):
         if os.path.exists(stale):
             os.remove(stale)
-    first = os.path.join(out, ODOMETRY if balance or args.turns else CALIBRATION)
+    first = os.path.join(out, ODOMETRY if balance or args.heading else CALIBRATION)
     command = [bag, "--robot-model", model, "--out", first]
     command += ["--ground-truth", args.ground_truth, "--fit", args.fit]
     if args.calibration:
@@ -157,7 +161,7 @@ def run(args) -> int:
     if args.json:
         command.append("--json")
     if not balance:
-        if not args.turns:
+        if not args.heading:
             return calibrate_odometry(command)
         captured = io.StringIO()
         with contextlib.redirect_stdout(captured):
@@ -168,10 +172,10 @@ def run(args) -> int:
             return status
         if not args.json:
             print(text, end="", flush=True)
-        turns = turns_step(args, model, first, out, calibrate_odometry)
+        heading = heading_step(args, model, first, out, calibrate_odometry, straight=False)
         if args.json:
             result = json.loads(text[text.index("{") :])
-            result["turns"] = turns
+            result["heading"] = heading
             print(json.dumps(result, indent=2))
         return 0
     captured = io.StringIO()
@@ -185,7 +189,7 @@ def run(args) -> int:
         print(text, end="", flush=True)
     balanced_file = os.path.join(out, BALANCED)
     figures = os.path.join(out, BALANCE_JSON)
-    scaled = os.path.join(out, SCALED if args.turns else CALIBRATION)
+    scaled = os.path.join(out, SCALED if args.heading else CALIBRATION)
     balanced_fit = os.path.join(out, BALANCED_FIT)
     for stale in (balanced_file, figures, balanced_fit):
         if os.path.exists(stale):
@@ -247,9 +251,9 @@ def run(args) -> int:
     text = captured.getvalue()
     if not args.json:
         print(text, end="", flush=True)
-    turns = None
-    if args.turns:
-        turns = turns_step(args, model, scaled, out, calibrate_odometry)
+    heading = None
+    if args.heading:
+        heading = heading_step(args, model, scaled, out, calibrate_odometry, straight=True)
     tyres = None
     if args.as_built and not stopped:
         tyres = tyre_errors(config, built, load_calibration(first, config), balanced, load_calibration(final, config))
@@ -257,8 +261,8 @@ def run(args) -> int:
         result = json.loads(fit_text[fit_text.index("{") :])
         result["balance"] = balanced
         result["straight"] = json.loads(text[text.index("{") :])
-        if turns is not None:
-            result["turns"] = turns
+        if heading is not None:
+            result["heading"] = heading
         if tyres is not None:
             result["tyres"] = tyres
         print(json.dumps(result, indent=2))
@@ -275,27 +279,29 @@ def run(args) -> int:
     return 0
 
 
-def turns_step(args, model: str, in_effect: str, out: str, calibrate_odometry) -> dict:
-    """The turns manoeuvre driven with the calibration file in_effect, and odometry's yaw-rate multiplier
-    fitted to it over that file into calibration.yaml; --fit turns' JSON with --json (else its text is
-    printed and the dict is empty). When the turns give none (they disagree, or slip beyond reason),
-    calibration.yaml is the file in_effect, the reason is printed and returned as {"error": reason}."""
-    bag = os.path.join(out, TURNS_BAG)
+def heading_step(args, model: str, in_effect: str, out: str, calibrate_odometry, *, straight: bool) -> dict:
+    """The heading manoeuvre driven with the calibration file in_effect, and odometry's heading model
+    fitted to it over that file into calibration.yaml (straight: in_effect's yaw per metre came from the
+    straight legs and is kept); --fit heading's JSON with --json (else its text is printed and the dict is
+    empty). When the drive gives none (a fit beyond what a calibration explains), calibration.yaml is the
+    file in_effect, the reason is printed and returned as {"error": reason}."""
+    bag = os.path.join(out, HEADING_BAG)
     with_fit = argparse.Namespace(**{**vars(args), "calibration": in_effect})
-    wall, _ = drive(with_fit, model, bag, "turns", args.side, log="turns")
+    wall, _ = drive(with_fit, model, bag, "heading", args.side, log="heading")
     command = [bag, "--robot-model", model, "--out", os.path.join(out, CALIBRATION), "--calibration", in_effect]
-    command += ["--fit", "turns", "--ground-truth", args.ground_truth, *(["--json"] if args.json else [])]
+    command += ["--fit", "heading", "--ground-truth", args.ground_truth, *(["--json"] if args.json else [])]
+    command += ["--keep-yaw-per-metre"] if straight else []
     if not args.json:
         print(f"  drive: {wall:.1f} s wall; bag {bag}", flush=True)
-        print("\nodometry's yaw-rate multiplier from U turns of the working radius, all that in effect:", flush=True)
+        print("\nodometry's heading model from a drive of every motion, all that in effect:", flush=True)
     captured, said = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(captured), contextlib.redirect_stderr(said):
         status = calibrate_odometry(command)
     text = captured.getvalue()
-    if status != 0:  # the calibration stands without the multiplier
+    if status != 0:  # the calibration stands without the heading model
         shutil.copyfile(in_effect, os.path.join(out, CALIBRATION))
         reason = said.getvalue().strip().replace("calibrate_odometry: ", "", 1)
-        print(f"no yaw-rate multiplier from the turns ({reason}); {CALIBRATION} is {os.path.basename(in_effect)}")
+        print(f"no heading model from the drive ({reason}); {CALIBRATION} is {os.path.basename(in_effect)}")
         return {"error": reason}
     if not args.json:
         print(text, end="", flush=True)

@@ -31,6 +31,7 @@ from ..plugins import load_calculator
 from .recording import DriveRecording, GnssTruth, PoseTruth
 
 STEP = 1.0  # [m] along GNSS ground truth between the fixes path lengths are taken at
+BIAS_WINDOW = 2.0  # [s] between the fixes imu_bias compares (the drive fit's windows)
 
 
 @dataclass(frozen=True)
@@ -82,6 +83,36 @@ def truth_path(truth: Union[PoseTruth, GnssTruth], heading_bias: float = 0.0) ->
     return truth.t_fix, x, y, heading
 
 
+def imu_bias(
+    config: RobotConfig,
+    recording: DriveRecording,
+    truth: GnssTruth,
+    calculator_for: Callable = load_calculator,
+    *,
+    correction: OdometryCorrection = NO_CORRECTION,
+    window: float = BIAS_WINDOW,
+) -> float:
+    """[rad] the IMU yaw's bias against the fixes' east/north frame, from the fixes and odometry's
+    translation: over windows between fixes, the fixes' displacement against odometry's, turned into
+    east/north by the IMU's yaw (less odometry's own at the window's start), by least squares on the
+    angle alone. What an end-point figure against GNSS needs when no drive fit estimated the bias (a
+    hector GNSS with reference heading 0 puts the simulator's x north, so the IMU's yaw reads 90 degrees
+    off east: taken as 0, the turns drive's end point read 6 m off where it was 0.6 m)."""
+    t_odo, x_odo, y_odo, yaw_odo = replay(config, recording, calculator_for, correction=correction)
+    inside = (truth.t_fix >= t_odo[0]) & (truth.t_fix <= t_odo[-1])
+    t, east, north = truth.t_fix[inside], truth.east[inside], truth.north[inside]
+    if len(t) < 2:
+        raise CalibrationError("the ground truth and the drive states do not overlap in time")
+    ends = np.searchsorted(t, t + window)
+    a = np.flatnonzero(ends < len(t))
+    b = ends[a]
+    fixes = (east[b] - east[a]) + 1j * (north[b] - north[a])
+    ox, oy, oyaw = (np.interp(t, t_odo, v) for v in (x_odo, y_odo, yaw_odo))
+    odometry = ((ox[b] - ox[a]) + 1j * (oy[b] - oy[a])) * np.exp(1j * (truth.yaw_at(t[a]) - oyaw[a]))
+    total = np.sum(fixes * np.conj(odometry))
+    return float(np.angle(total)) if abs(total) > 0.0 else 0.0
+
+
 def odometry_error(
     config: RobotConfig,
     recording: DriveRecording,
@@ -129,4 +160,4 @@ def _length(points: np.ndarray) -> float:
     return float(np.sum(np.hypot(*np.diff(points, axis=1))))
 
 
-__all__ = ["STEP", "OdometryError", "as_read_with", "odometry_error", "replay", "truth_path"]
+__all__ = ["BIAS_WINDOW", "STEP", "OdometryError", "as_read_with", "imu_bias", "odometry_error", "replay", "truth_path"]

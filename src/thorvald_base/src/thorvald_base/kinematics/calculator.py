@@ -14,7 +14,10 @@ passive_wheels)`` once, ``set_params(drives, passive_wheels)`` when parameters c
 ``odometry_correction`` (none unless a calibration sets it, :class:`OdometryCorrection`) corrects the
 yaw rate odometry reads from the drive states, the translation kept: tyres that slip in turns make the
 wheels' geometry read a turn a little short (as diff_drive_controller's ``wheel_separation_multiplier``
-corrects for skid steering), and a frame driven straight can read a slow turn it does not make.
+corrects for skid steering), a frame driven straight or crabbing can read a slow turn it does not make,
+and where the wheels disagree (re-steering into a spin or a turn, a toe) the frame turns as the wheels
+that carry it say, not as all of them alike: a frame on rigid tyres of unequal radii stands on three
+wheels, and the others turn almost free (the correction's ``wheel_weights``).
 """
 
 import math
@@ -25,7 +28,7 @@ from thorvald_model.errors import Problem
 from thorvald_model.layout import AxleLine, common_axle
 
 from ..errors import KinematicsError
-from .geometry import DEFAULT_PROJECTION, Layout, check_projection
+from .geometry import DEFAULT_PROJECTION, Layout, check_projection, inverse, matmul, transpose
 from .odometry import DEFAULT_ESTIMATOR, ESTIMATORS, integrate_se2, make_estimator, wheel_velocities
 from .types import CommandResult, DriveCommand, DriveState, OdometryResult, Pose, Twist
 
@@ -33,33 +36,134 @@ MAX_ODOMETRY_DT = 0.5  # [s]: a longer gap between states is a pause, not motion
 STOPPED_SPEED = 1e-9  # [m/s]: a wheel this slow has no direction of its own; it keeps its heading
 YAW_RATE_MULTIPLIER_RANGE = (0.9, 1.1)  # a tyre slips a turn short by a few per mille, never 10 %
 MAX_YAW_PER_METRE = 0.005  # [rad/m]: 0.3 degrees a metre is a bent frame or a broken module, not calibration
+# The weighted fit may read the wheels' disagreement as a turn at most this many times as strongly as the
+# plain fit (the largest gain of any wheel's velocity on the yaw rate): a frame on three of six wheels reads
+# it about twice as strongly (workshop:1: 1.9); beyond this the weights lean on wheels too close together
+# to tell a turn, and a bad fit would turn odometry wherever the wheels disagree
+MAX_WEIGHTED_GAIN = 4.0
 REALISABLE_TOLERANCE = 1e-9  # [m/s]: wheel-velocity change below which a twist counts as unchanged
 
 
 @dataclass(frozen=True)
 class OdometryCorrection:
-    """What a calibration adds to the yaw rate the drive states give (``calibrate_odometry --fit turns``
-    and ``--fit straight``): wz' = yaw_rate_multiplier wz + yaw_per_metre vx, the translation kept."""
+    """What a calibration adds to the yaw rate the drive states give (``calibrate_odometry --fit heading``,
+    ``--fit turns`` and ``--fit straight``), the translation kept::
+
+        wz' = yaw_rate_multiplier (wz + weighted) + yaw_per_metre vx + yaw_per_metre_sideways vy
+
+    where ``weighted`` is how much the yaw rate of the least-squares fit that weights each drive's wheel
+    by ``wheel_weights`` (in drive order; empty: all alike, weighted 0) differs from the estimator's.
+    Where the wheels agree it is 0; where they disagree (a wheel re-steering, a toe) the frame turns as
+    the wheels that carry it say."""
 
     yaw_rate_multiplier: float = 1.0
     yaw_per_metre: float = 0.0  # [rad/m] of travel along base_link's x: a turn read on a straight line, undone
+    yaw_per_metre_sideways: float = 0.0  # [rad/m] of travel along base_link's y: a turn read crabbing, undone
+    wheel_weights: Tuple[float, ...] = ()  # each drive's weight in the yaw rate's fit (mean 1); (): all alike
 
     def problems(self) -> List[str]:
+        """What is wrong with the values alone (calculator.odometry_correction also checks the weights
+        against the robot's wheels)."""
         out = []
         low, high = YAW_RATE_MULTIPLIER_RANGE
-        m, b = self.yaw_rate_multiplier, self.yaw_per_metre
-        if isinstance(m, bool) or not (isinstance(m, (int, float)) and low <= m <= high):
+        m, b, c = self.yaw_rate_multiplier, self.yaw_per_metre, self.yaw_per_metre_sideways
+        if not _number_in(m, low, high):
             out.append(f"yaw_rate_multiplier must be in [{low:g}, {high:g}], not {m!r}")
-        if isinstance(b, bool) or not (isinstance(b, (int, float)) and abs(b) <= MAX_YAW_PER_METRE):
+        if not _number_in(b, -MAX_YAW_PER_METRE, MAX_YAW_PER_METRE):
             out.append(f"yaw_per_metre must be within +-{MAX_YAW_PER_METRE:g} rad/m, not {b!r}")
+        if not _number_in(c, -MAX_YAW_PER_METRE, MAX_YAW_PER_METRE):
+            out.append(f"yaw_per_metre_sideways must be within +-{MAX_YAW_PER_METRE:g} rad/m, not {c!r}")
+        out += weight_problems(self.wheel_weights)
         return out
 
-    def yaw_rate(self, vx: float, wz: float) -> float:
-        """The corrected yaw rate [rad/s] of a body twist's vx [m/s] and wz [rad/s]."""
-        return self.yaw_rate_multiplier * wz + self.yaw_per_metre * vx
+    def yaw_rate(self, vx: float, wz: float, vy: float = 0.0, weighted: float = 0.0) -> float:
+        """The corrected yaw rate [rad/s] of a body twist's vx, vy [m/s] and wz [rad/s], weighted [rad/s]
+        the weights' change of wz (:meth:`BaseCalculator.weighted_change`)."""
+        return self.yaw_rate_multiplier * (wz + weighted) + self.yaw_per_metre * vx + self.yaw_per_metre_sideways * vy
 
 
 NO_CORRECTION = OdometryCorrection()
+
+
+def _number_in(value, low: float, high: float) -> bool:
+    return not isinstance(value, bool) and isinstance(value, (int, float)) and low <= value <= high
+
+
+def weight_problems(weights: Sequence[float]) -> List[str]:
+    """What is wrong with wheel weights alone: each a number >= 0 and their mean 1 (to 1e-6: a file holds
+    9 digits). What they do is bounded with the robot's wheels (MAX_WEIGHTED_GAIN)."""
+    if not weights:
+        return []
+    if not all(_number_in(w, 0.0, math.inf) for w in weights):
+        return [f"wheel_weights must each be a number >= 0, not {list(weights)!r}"]
+    mean = sum(weights) / len(weights)
+    if abs(mean - 1.0) > 1e-6:
+        return [f"wheel_weights must have the mean 1, not {mean:.9g}"]
+    return []
+
+
+def weighted_yaw_gains(layout: Layout, weights: Sequence[float]) -> Optional[Tuple[Tuple[float, float], ...]]:
+    """Per drive, (gx, gy) [1/m] such that sum gx vx_k + gy vy_k over the wheels' velocities is how much the
+    yaw rate of the least-squares fit weighting drive k by weights[k] differs from the plain fit's (the
+    layout's constraints kept); None when the weighted wheels do not determine the robot's motion.
+
+    The weighted fit minimises sum w_k |J_k t - v_k|^2 over realisable twists t = B^T z: t = P_W b_W with
+    P_W = B^T (B M_W B^T)^-1 B, M_W = sum w_k J_k^T J_k and b_W = sum w_k J_k^T v_k (geometry.py); its wz is
+    linear in the wheels' velocities, and so is its difference from the plain fit's."""
+    basis = layout.basis
+    bt = transpose(basis)
+    m = [[0.0] * 3 for _ in range(3)]
+    for w, x, y in zip(weights, layout.x, layout.y):
+        for i, row in enumerate(((1.0, 0.0, -y), (0.0, 1.0, x), (-y, x, x * x + y * y))):
+            for j in range(3):
+                m[i][j] += w * row[j]
+    try:
+        reduced = inverse(matmul(matmul(basis, m), bt))
+    except KinematicsError:
+        return None
+    p_w = matmul(matmul(bt, reduced), basis)[2]
+    p_1 = layout.lsq[2]
+    gains = []
+    for w, x, y in zip(weights, layout.x, layout.y):
+        # wz = P[2] . (vx, vy, x vy - y vx) summed with each wheel's weight (1 for the plain fit)
+        gx = w * (p_w[0] - y * p_w[2]) - (p_1[0] - y * p_1[2])
+        gy = w * (p_w[1] + x * p_w[2]) - (p_1[1] + x * p_1[2])
+        gains.append((gx, gy))
+    return tuple(gains)
+
+
+def weighted_gain_ratio(layout: Layout, weights: Sequence[float]) -> float:
+    """How much more strongly the weighted fit's yaw rate follows a wheel's velocity than the plain fit's:
+    the largest gain of a wheel's velocity on it over the plain fit's largest (inf where the weighted
+    wheels do not determine the motion)."""
+    gains = weighted_yaw_gains(layout, weights)
+    if gains is None:
+        return math.inf
+    p_1 = layout.lsq[2]
+    plain = [(p_1[0] - y * p_1[2], p_1[1] + x * p_1[2]) for x, y in zip(layout.x, layout.y)]
+    largest = max(math.hypot(px, py) for px, py in plain)
+    full = max(math.hypot(gx + px, gy + py) for (gx, gy), (px, py) in zip(gains, plain))
+    return full / largest if largest > 0 else math.inf
+
+
+def _weighted_gains(layout: Optional[Layout], correction: OdometryCorrection):
+    """The correction's weighted_yaw_gains for the layout (None without weights or layout);
+    KinematicsError when its weights do not fit the robot's wheels."""
+    weights = correction.wheel_weights
+    if not weights or layout is None:
+        return None
+    if len(weights) != len(layout.drives):
+        raise KinematicsError(
+            f"wheel_weights must give one weight per drive ({len(layout.drives)}), not {len(weights)}"
+        )
+    ratio = weighted_gain_ratio(layout, weights)
+    if ratio > MAX_WEIGHTED_GAIN:
+        said = "do not determine the robot's motion" if math.isinf(ratio) else f"read it {ratio:.1f} times as strongly"
+        raise KinematicsError(
+            f"wheel_weights {list(weights)!r}: the weighted wheels {said} as the plain fit (at most "
+            f"{MAX_WEIGHTED_GAIN:g}): weights that lean on too few wheels"
+        )
+    return weighted_yaw_gains(layout, weights)
 
 
 def unheard_drives(states: Sequence[DriveState]) -> Tuple[int, ...]:
@@ -94,6 +198,7 @@ class BaseCalculator:
         self._pose = Pose()
         self._last_time: Optional[float] = None
         self._correction = NO_CORRECTION
+        self._gains: Optional[Tuple[Tuple[float, float], ...]] = None  # the correction's weighted_yaw_gains
         self._partial: Dict[Tuple[int, ...], Optional[tuple]] = {}  # unheard drives -> lsq_for, or None
         self._last_motion = Twist()  # the last twist commanded that moves the robot
 
@@ -115,8 +220,10 @@ class BaseCalculator:
         drives = tuple(drives)
         self._check_layout(drives, tuple(passive_wheels))
         layout = Layout(drives, passive_wheels, self.projection)
+        gains = _weighted_gains(layout, self._correction)  # drives moved: the weights must still hold
         keep = self.layout is not None and len(self.layout.drives) == len(drives)
         self.layout = layout
+        self._gains = gains
         self._estimator = make_estimator(self.estimator_name, layout, self.seed)
         self._partial = {}
         if not keep:
@@ -173,7 +280,8 @@ class BaseCalculator:
         else:
             vx, vy, wz, res, blind = self._estimate_heard(unheard, steering, speed)
             translating = None
-        wz = self._correction.yaw_rate(vx, wz)
+        # the weights are every wheel's: with a drive unheard the heard ones' fit stands as it is
+        wz = self._correction.yaw_rate(vx, wz, vy, 0.0 if unheard else self.weighted_change(steering, speed))
         twist = Twist(vx, vy, wz)
         if not all(math.isfinite(v) for v in (vx, vy, wz)):
             return OdometryResult(twist, self._pose, res, dt, False, translating, unheard, blind)
@@ -227,7 +335,15 @@ class BaseCalculator:
         nothing: what a calibration compares with ground truth."""
         self._require()
         vx, vy, wz, _, _ = self._estimator.estimate(list(steering), list(speed))
-        return Twist(vx, vy, self._correction.yaw_rate(vx, wz))
+        return Twist(vx, vy, self._correction.yaw_rate(vx, wz, vy, self.weighted_change(steering, speed)))
+
+    def weighted_change(self, steering: Sequence[float], speed: Sequence[float]) -> float:
+        """[rad/s] how much the yaw rate of the fit weighting the wheels by the correction's wheel_weights
+        differs from the plain least-squares fit's, for these drive states (0 without weights)."""
+        if self._gains is None:
+            return 0.0
+        wvx, wvy = wheel_velocities(steering, speed)
+        return sum(gx * mx + gy * my for (gx, gy), mx, my in zip(self._gains, wvx, wvy))
 
     # ---- conveniences ---------------------------------------------------------------------
     @classmethod
@@ -255,6 +371,7 @@ class BaseCalculator:
         problems = correction.problems()
         if problems:
             raise KinematicsError("; ".join(problems))
+        self._gains = _weighted_gains(self.layout, correction)
         self._correction = correction
 
     def wheel_velocity(self, twist: Twist, index: int):
