@@ -46,6 +46,9 @@ The parameters, their defaults and what each means:
                           of its spawn x's strip (none: to the worker with the fewest robots)
 ``~gazebo_namespace``     where Gazebo's ROS API is offered (/gazebo; spawn_model's
                           ``-gazebo_namespace``): docs/coming-from-gazebo.md
+``~gazebo_states_rate``   ``model_states`` and ``link_states`` per simulated second, while
+                          subscribed [Hz] (50: ground truth's rate; 0: after every physics step,
+                          as Gazebo publishes them with every world update)
 ========================  ================================================================
 
 Pure: no rospy.
@@ -87,6 +90,7 @@ class SimulatorParams:
     physics_workers: int = 1  # 1: the node's own pybullet client; N >= 2: N worker processes (thorvald_sim.workers)
     worker_strips: Tuple[float, ...] = ()  # [m] N - 1 increasing x: worker k takes spawn x in its strip
     gazebo_namespace: str = "/gazebo"  # where Gazebo's ROS API is offered (thorvald_sim.gazebo.api)
+    gazebo_states_rate: float = 50.0  # [Hz] of model_states and link_states; 0: every physics step
 
     @classmethod
     def read(cls, get: Getter) -> "SimulatorParams":
@@ -132,6 +136,7 @@ class SimulatorParams:
             physics_workers=workers,
             worker_strips=strips,
             gazebo_namespace=_namespace(get("gazebo_namespace", d.gazebo_namespace)),
+            gazebo_states_rate=_number(get, "gazebo_states_rate", d.gazebo_states_rate, allow_zero=True),
         )
 
 

@@ -399,6 +399,21 @@ class SimRobot:
         pos, quat = p.multiplyTransforms(com, orn, *self._to_base_link)
         return tuple(pos), tuple(quat)
 
+    def frame_state(self) -> Tuple[Tuple[Vec3, Quat], Vec3, Vec3]:
+        """base_link in the world, its origin's velocity and the angular velocity (world axes): the
+        Gazebo API's model state, read with three calls."""
+        c = self.client
+        com, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=c)
+        pos, quat = p.multiplyTransforms(com, orn, *self._to_base_link)
+        v, w = p.getBaseVelocity(self.body, physicsClientId=c)
+        r = (pos[0] - com[0], pos[1] - com[1], pos[2] - com[2])
+        v_origin = (
+            v[0] + w[1] * r[2] - w[2] * r[1],
+            v[1] + w[2] * r[0] - w[0] * r[2],
+            v[2] + w[0] * r[1] - w[1] * r[0],
+        )
+        return (tuple(pos), tuple(quat)), v_origin, tuple(w)
+
     def odom_pose(self) -> Tuple[Vec3, Quat]:
         """base_link in the robot's odom frame, which is the spawn pose on the ground."""
         pos, quat = p.multiplyTransforms(*self._odom_inverse, *self.world_pose())

@@ -93,7 +93,7 @@ class SimulatorNode:
         self.tf_watch = TfWatcher(rospy.get_name(), self.io)  # other publishers of a robot's odom -> base_link
         self.diagnostics = NonBlockingPublisher("/diagnostics", DiagnosticArray)
         self.meter = PerformanceMeter(1.0 / params.diagnostics_rate) if params.diagnostics_rate else None
-        self.gazebo = GazeboApi(self, params.gazebo_namespace)  # Gazebo's /gazebo services and topics
+        self.gazebo = GazeboApi(self, params.gazebo_namespace, params.gazebo_states_rate)  # Gazebo's ROS API
         self.services = SimulatorServices(self)
         self.publish_clock()
         rospy.loginfo(
@@ -193,7 +193,7 @@ class SimulatorNode:
         reads = {io.robot.name: io.reads(drives, currents, odometry, tf_read, now) for io in live}
         stamp = rospy.Time.from_sec(now)
         # drive states and currents are read at the stamp's instant (whole nanoseconds), as they are published
-        states = self.gazebo.wanted()
+        states = self.gazebo.wanted(now)
         for death in self.sim.step(reads, positions=odometry, stamped=stamp.to_sec(), states=states):
             self.worker_died(death)
         live = [io for io in live if io.alive]
@@ -222,7 +222,7 @@ class SimulatorNode:
         """Simulated time back to zero (/gazebo/reset_simulation): /clock says 0 and everything periodic
         starts again from there; nodes on /use_sim_time see time jump back, as with Gazebo."""
         self.sim.restart_time()
-        for grid in (self.clock, self.odometry, self.drives, self.currents):
+        for grid in (self.clock, self.odometry, self.drives, self.currents, self.gazebo.grid):
             grid.pause()
         self.pacer.paused()
         self.waits.restart()

@@ -159,7 +159,7 @@ def test_parameters_are_read_once_with_their_defaults():
     params = SimulatorParams.read(get)
     assert params == SimulatorParams(real_time_factor=0.0, seed=7, world="slope")
     assert params.clock_rate == 80.0 and params.publish_tf is True
-    assert len(asked) == len(set(asked)) == 22  # every parameter, each once
+    assert len(asked) == len(set(asked)) == 23  # every parameter, each once
     assert (params.drive_state_rate, params.drive_current_rate) == (80.0, 10.0)
     assert (params.physics, params.physics_rate, params.solver_iterations) == ("default", 240.0, 50)
 

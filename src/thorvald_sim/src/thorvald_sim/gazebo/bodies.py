@@ -172,6 +172,10 @@ class GazeboBodies:
     def state(self, model: str, link: Optional[int] = MODEL_FRAME) -> Tuple[Pose, Vec3, Vec3]:
         """A model's frame (link MODEL_FRAME) or a link frame (its pybullet index): world pose, the
         origin's linear velocity, the angular velocity."""
+        robot = self.sim.robots.get(model)
+        if robot is not None and link is MODEL_FRAME:  # base_link (the topics ask for it every time)
+            (position, q), v, w = robot.frame_state()
+            return (position, frames.normalised(q)), v, w
         body = self.body(model)
         built = self.models.get(model)
         index = -1 if link is MODEL_FRAME else link
