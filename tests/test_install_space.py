@@ -152,6 +152,9 @@ def test_code_and_package_files_come_from_the_install_space(install):
         "share/thorvald_example_robots/launch/thorvald_ii_4wd4ws_std_sim.launch",
         "share/xacro/xacro",
         "lib/xacro/xacro",
+        # gazebo_ros: users' Gazebo launch files and spawn lines
+        "share/gazebo_ros/launch/empty_world.launch",
+        "lib/gazebo_ros/spawn_model",
     ):
         assert os.path.exists(os.path.join(install, path)), path
         assert not os.path.realpath(os.path.join(install, path)).startswith(os.path.join(WS, "src")), path

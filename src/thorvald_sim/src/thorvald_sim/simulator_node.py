@@ -86,15 +86,15 @@ class SimulatorNode:
         self.odometry = RateGrid(params.odometry_rate, self.sim.dt)
         self.drives = RateGrid(params.drive_state_rate, self.sim.dt)
         self.currents = RateGrid(params.drive_current_rate, self.sim.dt)
-        # Written in the loop on non-blocking sockets (thorvald_base.publishing): a writer thread per reader
-        # cost more than the physics; a blocking write froze the simulation when one reader's link dropped.
+        # written in the loop, never a thread per reader, never waiting (thorvald_base.publishing)
         self.clock_pub = NonBlockingPublisher("/clock", Clock)
         self.tf = NonBlockingPublisher("/tf", TFMessage)
         self.tf_watch = TfWatcher(rospy.get_name(), self.io)  # other publishers of a robot's odom -> base_link
         self.diagnostics = NonBlockingPublisher("/diagnostics", DiagnosticArray)
         self.meter = PerformanceMeter(1.0 / params.diagnostics_rate) if params.diagnostics_rate else None
-        self.gazebo = GazeboApi(self, params.gazebo_namespace, params.gazebo_states_rate)  # Gazebo's ROS API
-        self.services = SimulatorServices(self)
+        with self.lock:  # a request that comes as soon as a service is offered waits for both
+            self.gazebo = GazeboApi(self, params.gazebo_namespace, params.gazebo_states_rate)  # Gazebo's API
+            self.services = SimulatorServices(self)
         self.publish_clock()
         rospy.loginfo(
             "simulator: world %s (%s), physics %s: %g Hz, %d solver iterations, real-time factor %s%s",

@@ -79,7 +79,6 @@ from .frames import ORIGIN
 ZERO = (0.0, 0.0, 0.0)
 MAX_FORCE = 1e7  # [N] and [N m]: a wrench or an effort beyond this is refused (pybullet would fly the body away)
 MAX_POSITION = 1e6  # [m] from the origin: a pose beyond this is refused
-JOINT_TYPES = {"revolute": 0, "continuous": 1, "prismatic": 2}
 
 
 def _vec(v) -> Tuple[float, float, float]:
@@ -512,7 +511,7 @@ class GazeboApi:
             except WorkerError as e:
                 res.status_message = f"GetJointProperties: {e}"
                 return res
-        res.type = JOINT_TYPES[joint.kind]
+        res.type = res.REVOLUTE  # whatever the joint, as gazebo_ros's api plugin answers (its "FIXME")
         res.position, res.rate = [position], [rate]
         res.success, res.status_message = True, "GetJointProperties: got properties"
         return res
