@@ -399,8 +399,9 @@ def heading_json(fit: HeadingFit, said: str, errors, path: str) -> dict:
     values = (c.yaw_rate_multiplier, c.yaw_per_metre, c.yaw_per_metre_sideways)
     in_effect = (fit.in_effect.yaw_rate_multiplier, fit.in_effect.yaw_per_metre, fit.in_effect.yaw_per_metre_sideways)
     out = {"fit": "heading", "ground_truth_source": said, "windows": fit.windows}
-    for name, value, sd, excited, was in zip(names, values, fit.sd, fit.excited, in_effect):
-        out[name] = {"value": value, "sd": _number(sd), "excited": excited, "in_effect": was}
+    for name, value, sd, excited, kept, was in zip(names, values, fit.sd, fit.excited, fit.undetermined, in_effect):
+        # excited: used; undetermined: moved less than DETERMINED sd from the value in effect, which it keeps
+        out[name] = {"value": value, "sd": _number(sd), "excited": excited, "undetermined": kept, "in_effect": was}
     out["wheel_weights"] = {
         "value": list(c.wheel_weights),
         "told": fit.weights_told,

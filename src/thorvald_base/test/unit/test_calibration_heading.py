@@ -19,7 +19,7 @@ from calibration_test_helpers import MIXED, synthetic_drive
 
 from thorvald_base.calibration import DriveRecording, GnssTruth, PoseTruth
 from thorvald_base.calibration.calibration_file import changes_yaml, parse_calibration_values, read_calibration
-from thorvald_base.calibration.heading import MOTIONS, WINDOW, heading_fit
+from thorvald_base.calibration.heading import MOTIONS, WINDOW, describe, heading_fit
 from thorvald_base.calibration.odometry_error import imu_bias
 from thorvald_base.errors import CalibrationError, KinematicsError
 from thorvald_base.kinematics import DriveState, OdometryCorrection
@@ -270,6 +270,24 @@ def test_the_imus_bias_does_not_matter_and_its_noise_averages_out(square):
     ):
         assert abs(value - truth) < 3 * sd < 0.003
     assert max(c.wheel_weights[1::2]) < 0.05  # what the drive tells: drives 1 and 3 carry nothing
+
+
+@pytest.mark.slow  # a fit over two minutes of samples
+def test_what_the_drive_moves_less_than_two_standard_uncertainties_stays_as_in_effect(square):
+    # the IMU's noise five times as large as above: m, b and c move by less than twice their uncertainties
+    # (0.0033, 0.0027 and 0.0044) from the values in effect, and stay there; the weights, which the
+    # windows where the wheels disagree tell, are fitted
+    recording, calc = drawn_drive(square, seed=3)
+    _, gnss = truth_of(recording, calc, OdometryCorrection(0.995, 0.0006, -0.001, PAIR), bias=1.5, noise=0.02)
+    in_effect = OdometryCorrection(1.0, 0.0, 0.0)
+    fit = heading_fit(square, [(recording, gnss)], in_effect)
+    c = fit.correction
+    assert fit.undetermined == (True, True, True) and fit.excited == (False, False, False)
+    assert (c.yaw_rate_multiplier, c.yaw_per_metre, c.yaw_per_metre_sideways) == (1.0, 0.0, 0.0)
+    assert fit.weights_told and max(c.wheel_weights[1::2]) < 0.05
+    assert all(0.002 < sd < 0.006 for sd in fit.sd)
+    text = "\n".join(describe(fit))
+    assert "  c (yaw per metre along y)    +0.000000 rad/m (not determined: within 2 of its ± 0.0044" in text
 
 
 @pytest.mark.slow  # a fit over a minute of samples

@@ -33,7 +33,10 @@ its orientation carries white noise) less the model's integrated yaw rate is the
 are fitted first with the weights as in effect, then with the log of each weight as well, by
 Levenberg–Marquardt with priors at the values in effect: weak for m, b and c (a parameter the drive does
 not excite, c on a robot that cannot crab, stays where it was), and on the weights all alike with
-LOG_WEIGHT_SD. The weights are used only where they take WEIGHTS_TOLD of the windows' squared error off
+LOG_WEIGHT_SD. One of m, b and c that the drive moves by less than DETERMINED standard uncertainties from
+its value in effect stays there too, and the rest are fitted again without it (the heading drive's 8 m
+of crab legs gave c from 0.0011 +- 0.002 to -0.0015 +- 0.010 rad/m on seed 4's robots). The weights are
+used only where they take WEIGHTS_TOLD of the windows' squared error off
 (a differential robot's two wheels never disagree; a frame on soft tyres may stand on all its wheels
 alike) and leave less heading error in all over the windows where the wheels disagree than the fit
 without them (fitting each window's shape better can still add up worse), and returned with the mean
@@ -77,6 +80,7 @@ LOG_WEIGHT_SD = 3.0  # a factor e^3 = 20 between two wheels' weights costs as mu
 LINEAR_SD = 10.0  # m, b [rad/m] and c [rad/m]: a prior so weak that only an unexcited one stays
 KEPT_SD = 1e-9  # [rad/m]: b kept as in effect
 MIN_WINDOWS = 20
+DETERMINED = 2.0  # standard uncertainties a fitted m, b or c must move from the value in effect to be used
 WEIGHTS_TOLD = 0.05  # of the windows' squared heading error the weights must take off to be used
 MAX_ITERATIONS = 60
 CONVERGED = 1e-10
@@ -113,6 +117,7 @@ class HeadingFit:
     motions: Tuple[MotionHeading, ...]
     kept_yaw_per_metre: bool = False  # b kept as in effect (the straight legs'), not fitted
     weights_said: str = ""  # why the weights were kept as in effect, if they were
+    undetermined: Tuple[bool, bool, bool] = (False, False, False)  # m, b, c: moved less than DETERMINED sd: kept
 
 
 @dataclass(frozen=True)
@@ -157,57 +162,71 @@ def heading_fit(
     prior = _params_of(in_effect, n)
     prior[3:] = np.maximum(prior[3:], math.log(1e-6))  # a weight of 0 in effect: drawn back from far below
     prior[3:] -= np.mean(prior[3:])
-    scale = np.array([LINEAR_SD, KEPT_SD if keep_yaw_per_metre else LINEAR_SD, LINEAR_SD] + [LOG_WEIGHT_SD] * n)
 
     def windows_of(p: np.ndarray) -> np.ndarray:
         return _window_rates(drive, layout, p, n)
 
-    def residuals(p: np.ndarray) -> np.ndarray:
-        return np.concatenate([drive.truth - windows_of(p), PRIOR_ROW * (p - prior) / scale])
-
     windows = len(drive.truth)
-    # the weights kept as in effect first (m, b and c enter linearly), then free: the weights are told
-    # where they take WEIGHTS_TOLD of the windows' squared error off (a frame that stands on all its
-    # wheels alike, or wheels that never disagree, leave them as they were)
-    kept = prior[3:]
-    linear = _solve(lambda q: residuals(np.concatenate([q, kept])), prior[:3].copy())
-    p = _solve(residuals, np.concatenate([linear, kept]))
-    cost_kept = _cost(residuals(np.concatenate([linear, kept]))[:windows])
-    weights_told = cost_kept - _cost(residuals(p)[:windows]) > WEIGHTS_TOLD * cost_kept
-    # the weights act where the wheels disagree: they must also leave less heading there in all, not only
-    # fit each window's shape better (on field:3 the windows' squared error fell by half while the
-    # re-steering windows' sum went from +4 to +8 degrees)
     resteering = np.array([motion_of(drive, a, z) == "re-steering" for a, z in drive.bounds], dtype=bool)
-    sum_kept = abs(float(np.sum((drive.truth - windows_of(np.concatenate([linear, kept])))[resteering])))
-    sum_free = abs(float(np.sum((drive.truth - windows_of(p))[resteering])))
-    said = "" if weights_told else "not told apart: the wheels never disagreed, or alike fit as well"
-    if weights_told and sum_free > sum_kept:
-        weights_told = False
-        said = (
-            f"refused: they fit each window where the wheels disagree better, but leave more heading there in all "
-            f"({math.degrees(sum_free):.1f} against {math.degrees(sum_kept):.1f} degrees without them)"
-        )
-    if not weights_told:
-        p = np.concatenate([linear, kept])
-    r = residuals(p)
-    jac = _jacobian(residuals, p, r)[:, :3]
-    data = jac[:windows]
-    sigma2 = float(r[:windows] @ r[:windows]) / max(1, windows - 3)
-    try:
-        cov = sigma2 * np.linalg.inv(jac.T @ jac)
-        sd = tuple(float(math.sqrt(max(cov[k, k], 0.0))) for k in range(3))
-    except np.linalg.LinAlgError:
-        sd = (math.nan,) * 3
-    # excited: the windows alone pin m, b or c far better than its prior (a tenth of the prior's sd)
-    told = np.sqrt(np.sum(data * data, axis=0)) * scale[:3] / PRIOR_ROW > 10.0
+
+    def fit_with(scale: np.ndarray):
+        """(p, weights_told, said, sd of m, b and c, told) with the priors' scale."""
+
+        def residuals(p: np.ndarray) -> np.ndarray:
+            return np.concatenate([drive.truth - windows_of(p), PRIOR_ROW * (p - prior) / scale])
+
+        # the weights kept as in effect first (m, b and c enter linearly), then free: the weights are told
+        # where they take WEIGHTS_TOLD of the windows' squared error off (a frame that stands on all its
+        # wheels alike, or wheels that never disagree, leave them as they were)
+        kept = prior[3:]
+        linear = _solve(lambda q: residuals(np.concatenate([q, kept])), prior[:3].copy())
+        p = _solve(residuals, np.concatenate([linear, kept]))
+        cost_kept = _cost(residuals(np.concatenate([linear, kept]))[:windows])
+        weights_told = cost_kept - _cost(residuals(p)[:windows]) > WEIGHTS_TOLD * cost_kept
+        # the weights act where the wheels disagree: they must also leave less heading there in all, not
+        # only fit each window's shape better (on field:3 the windows' squared error fell by half while
+        # the re-steering windows' sum went from +4 to +8 degrees)
+        sum_kept = abs(float(np.sum((drive.truth - windows_of(np.concatenate([linear, kept])))[resteering])))
+        sum_free = abs(float(np.sum((drive.truth - windows_of(p))[resteering])))
+        said = "" if weights_told else "not told apart: the wheels never disagreed, or alike fit as well"
+        if weights_told and sum_free > sum_kept:
+            weights_told = False
+            said = (
+                f"refused: they fit each window where the wheels disagree better, but leave more heading there "
+                f"in all ({math.degrees(sum_free):.1f} against {math.degrees(sum_kept):.1f} degrees without them)"
+            )
+        if not weights_told:
+            p = np.concatenate([linear, kept])
+        r = residuals(p)
+        jac = _jacobian(residuals, p, r)[:, :3]
+        data = jac[:windows]
+        sigma2 = float(r[:windows] @ r[:windows]) / max(1, windows - 3)
+        try:
+            cov = sigma2 * np.linalg.inv(jac.T @ jac)
+            sd = np.array([math.sqrt(max(cov[k, k], 0.0)) for k in range(3)])
+        except np.linalg.LinAlgError:
+            sd = np.full(3, math.nan)
+        # excited: the windows alone pin m, b or c far better than its prior (a tenth of the prior's sd)
+        told = np.sqrt(np.sum(data * data, axis=0)) * scale[:3] / PRIOR_ROW > 10.0
+        return p, weights_told, said, sd, told
+
+    scale = np.array([LINEAR_SD, KEPT_SD if keep_yaw_per_metre else LINEAR_SD, LINEAR_SD] + [LOG_WEIGHT_SD] * n)
+    p, weights_told, said, sd, told = fit_with(scale)
     told[1] = told[1] and not keep_yaw_per_metre
+    # determined: the drive moves m, b or c from the value in effect by more than DETERMINED of its
+    # standard uncertainty; one it does not (c from the heading drive's 8 m of crab legs: 0.0011 +- 0.002
+    # to 0.0015 +- 0.01 rad/m) stays as in effect, and the rest are fitted again without it
+    undetermined = told & (np.abs(p[:3] - prior[:3]) < DETERMINED * sd)
+    if np.any(undetermined):
+        scale[:3][undetermined] = KEPT_SD
+        p, weights_told, said, sd_again, _ = fit_with(scale)
+        sd = np.where(undetermined, sd, sd_again)
+        told &= ~undetermined
+    in_effect_linear = (in_effect.yaw_rate_multiplier, in_effect.yaw_per_metre, in_effect.yaw_per_metre_sideways)
+    linear = [float(p[k]) if told[k] else in_effect_linear[k] for k in range(3)]
+    sd = tuple(float(v) for v in sd)
     weights = np.exp(p[3:] - np.max(p[3:]))
-    correction = OdometryCorrection(
-        float(p[0]),
-        in_effect.yaw_per_metre if keep_yaw_per_metre else float(p[1]),
-        float(p[2]) if told[2] else in_effect.yaw_per_metre_sideways,
-        _mean_one(weights) if weights_told else in_effect.wheel_weights,
-    )
+    correction = OdometryCorrection(*linear, _mean_one(weights) if weights_told else in_effect.wheel_weights)
     problems = correction.problems()
     if problems:
         raise CalibrationError(
@@ -231,6 +250,7 @@ def heading_fit(
         _by_motion(drive, before, after),
         keep_yaw_per_metre,
         said,
+        (bool(undetermined[0]), bool(undetermined[1]), bool(undetermined[2])),
     )
 
 
@@ -427,6 +447,8 @@ def describe(fit: HeadingFit) -> List[str]:
     def told(k: int) -> str:
         if k == 1 and fit.kept_yaw_per_metre:
             return "(kept: the straight legs')"
+        if fit.undetermined[k]:
+            return f"(not determined: within {DETERMINED:g} of its ± {fit.sd[k]:.2g} of the value in effect, kept)"
         return f"± {fit.sd[k]:.2g}" if fit.excited[k] else "(not excited: kept)"
 
     weights = ", ".join(f"drive{k} {w:.3f}" for k, w in enumerate(c.wheel_weights)) or "all alike"
