@@ -32,3 +32,9 @@ class ParameterError(ThorvaldBaseError):
 class CalibrationError(ThorvaldBaseError):
     """A recorded drive cannot calibrate odometry (too little of it, no ground truth, or it excites
     no parameter); the message says which and why."""
+
+
+class MalformedFrame(ThorvaldBaseError, ValueError):
+    """A CAN frame whose length or content does not fit its identifier's layout
+    (:mod:`thorvald_base.can.protocol`); the devices count it and go on. Also a ValueError, as it was
+    before it joined this hierarchy, for code that catches that."""

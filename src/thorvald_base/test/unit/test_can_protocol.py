@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 
 from thorvald_base.can import protocol as pr
 from thorvald_base.can.dbc import main, robot_dbc
+from thorvald_base.errors import MalformedFrame
 from thorvald_model import load_robot_config
 from thorvald_sim.can_emulator import load_dbc
 
@@ -231,7 +232,7 @@ def test_decoders_take_any_payload(data):
     for decode in DECODERS:
         try:
             decode(data)
-        except pr.MalformedFrame:
+        except MalformedFrame:
             assert len(data) != 8 or decode is pr.decode_tx_pdo4
 
 

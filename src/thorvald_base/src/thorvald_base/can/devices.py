@@ -7,6 +7,7 @@ LOST_AFTER seconds is in lost connection until it is heard again; any frame it o
 
 from typing import Dict, List, Optional, Sequence, Tuple, Union
 
+from ..errors import MalformedFrame
 from ..kinematics import DriveCommand
 from ..modes import MODE_PRE_INITIATION
 from . import protocol as pr
@@ -36,7 +37,7 @@ class Device:
         self.last_heard = time
         try:
             self._decode(can_id, bytes(data))
-        except pr.MalformedFrame:
+        except MalformedFrame:
             self.malformed += 1
         return True
 

@@ -22,6 +22,8 @@ import struct
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
+from ..errors import MalformedFrame
+
 _SOURCE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
 
@@ -127,10 +129,6 @@ _bbbbhbB = struct.Struct("<bbbbhbB")
 _BBHHxx = struct.Struct("<BBHHxx")
 _BBHHH = struct.Struct("<BBHHH")
 _BB = struct.Struct("<BBxxxxxx")
-
-
-class MalformedFrame(ValueError):
-    """A frame whose length or content does not fit its identifier's layout."""
 
 
 # ---- scalings: physical <-> raw, per drive --------------------------------------------------
