@@ -34,7 +34,8 @@ PKG = os.path.join(ROOT, "src", "thorvald_model")
 sys.path.insert(0, os.path.join(PKG, "src"))
 
 from thorvald_model.description import generate_urdf  # noqa: E402
-from thorvald_model.schema import YamlBoundError, load_yaml  # noqa: E402
+from thorvald_model.errors import YamlBoundError  # noqa: E402
+from thorvald_model.schema import load_yaml  # noqa: E402
 
 TARGET_9WD9WS = 1.0  # [s], cold
 TARGET_GROWTH = 1.5  # time per drive at 100 drives / at 10 drives

@@ -19,7 +19,8 @@ from geometry_msgs.msg import TransformStamped
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 
-from thorvald_model.joint_tree import JointTree, UrdfError, joint_positions
+from thorvald_model.errors import UrdfError
+from thorvald_model.joint_tree import JointTree, joint_positions
 
 from .conversions import transform_msg
 from .errors import ParameterError

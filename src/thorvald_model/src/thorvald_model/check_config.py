@@ -24,8 +24,8 @@ from typing import Dict, List, Optional
 
 from .check_report import report
 from .config import RobotConfig, load_robot_config
-from .description import XacroError, generate_urdf
-from .errors import ConfigError, UnknownRobotError
+from .description import generate_urdf
+from .errors import ConfigError, UnknownRobotError, XacroError
 from .examples import robot_file
 from .plugins import calculator_loader, calculator_problems
 

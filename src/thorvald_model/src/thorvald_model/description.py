@@ -14,7 +14,7 @@ The generated description is then normalised and checked as check_urdf would
 (:mod:`thorvald_model.urdf_check`): a link reference written ``/base_link`` (older generators) or
 ``thorvald_001//base_link`` (the two tf_prefix conventions mixed) means ``base_link`` /
 ``thorvald_001/base_link``, as in tf2, and a broken tree (a joint naming a link that does not exist)
-stops with every problem (:class:`~thorvald_model.urdf_check.UrdfCheckError`) before anything runs.
+stops with every problem (:class:`~thorvald_model.errors.UrdfCheckError`) before anything runs.
 
 Pure: no rospy, no messages. ``$(find pkg)`` in a user's extras resolves through rospack.
 """
@@ -30,31 +30,14 @@ import yaml
 
 from .config import load_robot_config, parse_robot_config
 from .datum import load_datum
-from .errors import ConfigError, ThorvaldModelError
+from .errors import ConfigError, RobotConfigAbort, UrdfCheckError, XacroError
 from .frames import normalize_tf_prefix
 from .resources import package_folder
-from .urdf_check import UrdfCheckError, normalize_document, urdf_problems
+from .urdf_check import normalize_document, urdf_problems
 
 # The package folder when this module runs from the source tree (or the devel space, which relays
 # to it); in an install space the package's files are under share/thorvald_model instead.
 PACKAGE_DIR = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-
-
-class XacroError(ThorvaldModelError):
-    """xacro failed on something other than the robot configuration (e.g. a broken extras file)."""
-
-
-class RobotConfigAbort(BaseException):
-    """Carries a ConfigError out of xacro.
-
-    xacro catches every ``Exception`` while it evaluates an expression and again in its ``main()``,
-    where it prints its own message and the file stack. A BaseException passes through both, so
-    the caller can report the loader's message alone.
-    """
-
-    def __init__(self, error: ConfigError):
-        super().__init__(str(error))
-        self.error = error
 
 
 def package_file(*parts: str) -> str:

@@ -1,7 +1,15 @@
-"""Errors of the thorvald_model package."""
+"""Errors of the thorvald_model package: one base class, :class:`ThorvaldModelError`, for everything
+the package refuses with a message that says why; a file's every problem as a :class:`ConfigError`.
+
+Each class keeps the built-in class it was before it joined this module (a ``ValueError``, a YAML
+error), for code that catches that. One class is not an error of the package's: RobotConfigAbort, a
+``BaseException`` that carries a ConfigError out of xacro and never reaches a user.
+"""
 
 from dataclasses import dataclass
 from typing import Any, Sequence
+
+import yaml
 
 from .value_text import value_text
 
@@ -52,6 +60,14 @@ class ConfigError(ThorvaldModelError):
         super().__init__("\n".join([header] + ["  " + line for line in lines]))
 
 
+class UrdfCheckError(ConfigError):
+    """A robot description that breaks urdfdom's rules (:mod:`thorvald_model.urdf_check`); every
+    problem is listed."""
+
+    def __init__(self, source: str, problems: Sequence[Problem]):
+        super().__init__(source, problems, what="robot description")
+
+
 class UnknownRobotError(ThorvaldModelError, LookupError):
     """A robot named by a name that is none of the example robots' (:mod:`thorvald_model.examples`).
 
@@ -97,3 +113,35 @@ class PluginTypeError(PluginError):
 
 class PluginDescriptionError(PluginError):
     """A package's plugin description file is missing or malformed."""
+
+
+class XacroError(ThorvaldModelError):
+    """xacro failed on something other than the robot configuration (e.g. a broken extras file)."""
+
+
+class RobotConfigAbort(BaseException):
+    """Carries a ConfigError out of xacro (:mod:`thorvald_model.description`); not an error of its own.
+
+    xacro catches every ``Exception`` while it evaluates an expression and again in its ``main()``,
+    where it prints its own message and the file stack. A BaseException passes through both, so
+    the caller can report the loader's message alone.
+    """
+
+    def __init__(self, error: ConfigError):
+        super().__init__(str(error))
+        self.error = error
+
+
+class YamlBoundError(ThorvaldModelError, yaml.MarkedYAMLError):
+    """A document past one of the bounds of :class:`thorvald_model.schema.BoundedLoader`; a YAML
+    error as well (PyYAML's ``MarkedYAMLError``: its place in the document), as PyYAML's own are."""
+
+
+class UrdfError(ThorvaldModelError, ValueError):
+    """A robot description whose joints or masses cannot be read (:mod:`thorvald_model.joint_tree`,
+    :mod:`thorvald_model.mass_properties`); the message says which and why. Also a ValueError, as it
+    was before it joined this hierarchy."""
+
+
+class StatePublisherError(ThorvaldModelError):
+    """The state_publisher shim cannot start robot_state_publisher; the message says why."""

@@ -11,8 +11,8 @@ import argparse
 import sys
 from typing import List, Optional
 
-from .description import XacroError, generate_urdf
-from .errors import ConfigError
+from .description import generate_urdf
+from .errors import ConfigError, XacroError
 
 
 def main(argv: Optional[List[str]] = None) -> int:

@@ -13,15 +13,13 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Dict, Iterable, List, Mapping, Optional, Tuple, Union
 
+from .errors import UrdfError
+
 Vec3 = Tuple[float, float, float]
 Quat = Tuple[float, float, float, float]
 Transform = Tuple[Vec3, Quat]
 MOVING = ("revolute", "continuous", "prismatic")  # URDF joint types
 FIXED = "fixed"
-
-
-class UrdfError(ValueError):
-    """A robot description whose joints cannot be read; the message says which and why."""
 
 
 @dataclass(frozen=True)

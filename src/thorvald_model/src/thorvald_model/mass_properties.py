@@ -13,7 +13,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Dict, Mapping, Optional, Sequence, Tuple, Union
 
-from .joint_tree import IDENTITY_TRANSFORM, JointTree, Transform, UrdfError, Vec3, _triple, compose, rotate
+from .errors import UrdfError
+from .joint_tree import IDENTITY_TRANSFORM, JointTree, Transform, Vec3, _triple, compose, rotate
 
 __all__ = ["MassProperties", "link_poses", "mass_properties"]
 

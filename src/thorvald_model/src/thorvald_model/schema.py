@@ -18,7 +18,7 @@ from typing import Any, Callable, Iterable, List, Mapping, Optional, Sequence, T
 
 import yaml
 
-from .errors import MISSING, ConfigError, Problem
+from .errors import MISSING, ConfigError, Problem, YamlBoundError
 from .value_text import value_text, value_text_whole
 
 REQUIRED = object()
@@ -108,10 +108,6 @@ MAX_YAML_NODES = 100_000  # [values] (scalars, lists and mappings, mapping keys 
 # [characters] of an integer: Python 3.11 refuses to convert longer decimal ones, and 3.8 takes time
 # quadratic in the length to do it
 MAX_YAML_INT = 4300
-
-
-class YamlBoundError(yaml.MarkedYAMLError):
-    """A document past one of the bounds of :class:`BoundedLoader`."""
 
 
 class _Bounded:

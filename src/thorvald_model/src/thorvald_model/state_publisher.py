@@ -21,12 +21,10 @@ from typing import List, Optional, Sequence, Tuple
 
 import rosgraph.names
 
+from .errors import StatePublisherError
+
 DEFAULT_JOINT_STATES = "base_driver/joint_states"
 EXIT_USAGE = 2
-
-
-class StatePublisherError(Exception):
-    """The shim cannot start robot_state_publisher; the message says why."""
 
 
 def robot_namespace(node_namespace: str) -> str:

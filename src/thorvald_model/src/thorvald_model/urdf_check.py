@@ -37,26 +37,18 @@ import re
 import xml.etree.ElementTree as ET
 from typing import Any, Callable, Dict, Iterable, Iterator, List, Optional, Sequence, Tuple
 
-from .errors import MISSING, ConfigError, Problem
+from .errors import MISSING, Problem, UrdfCheckError
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 NEEDS_LIMIT = ("revolute", "prismatic")
 NO_AXIS = ("fixed", "floating")  # urdfdom reads <axis> of the other types only
 CLOSE_NAME = 0.6  # difflib ratio from which an existing link is offered as the one meant
 CLOSEST = 3  # at most this many names offered
-WHAT = "robot description"
 
 # urdfdom's strToDouble: a C++ stream reading a double from the whole text (leading blanks allowed,
 # trailing ones not; no inf, nan or hexadecimal)
 _NUMBER = re.compile(r"\s*[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z")
 _REPEATED_SLASHES = re.compile(r"/{2,}")
-
-
-class UrdfCheckError(ConfigError):
-    """A robot description that breaks urdfdom's rules; every problem is listed."""
-
-    def __init__(self, source: str, problems: Sequence[Problem]):
-        super().__init__(source, problems, what=WHAT)
 
 
 def normalize_frame(name: str) -> str:
@@ -408,7 +400,6 @@ def checked_urdf(xml: str, source: str) -> str:
 
 __all__ = [
     "JOINT_TYPES",
-    "UrdfCheckError",
     "checked_tree",
     "checked_urdf",
     "closest_names",

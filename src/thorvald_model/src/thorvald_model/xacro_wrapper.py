@@ -32,8 +32,8 @@ from typing import Any, Callable, Iterator, List, Optional
 import xacro
 import yaml
 
-from .description import RobotConfigAbort, check_document, shared_loader
-from .urdf_check import UrdfCheckError
+from .description import check_document, shared_loader
+from .errors import RobotConfigAbort, UrdfCheckError
 
 
 def _safe_default_loader() -> None:

@@ -12,7 +12,7 @@ from urdf_helpers import FIGURE5, PKG, structural_differences
 
 from thorvald_model.check_config import main as check_config
 from thorvald_model.description import generate_urdf
-from thorvald_model.urdf_check import UrdfCheckError
+from thorvald_model.errors import UrdfCheckError
 
 STD = os.path.join(PKG, "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
 DATA = os.path.join(PKG, "test", "data")

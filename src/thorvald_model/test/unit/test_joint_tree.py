@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from thorvald_model.joint_tree import JointTree, UrdfError, joint_positions, quaternion_from_rpy
+from thorvald_model.errors import UrdfError
+from thorvald_model.joint_tree import JointTree, joint_positions, quaternion_from_rpy
 
 URDF = """<robot name="t">
   <link name="base"/><link name="arm"/><link name="slide"/><link name="copy"/><link name="cam"/>

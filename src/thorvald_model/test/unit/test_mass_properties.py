@@ -8,7 +8,7 @@ import xml.etree.ElementTree as ET
 import pytest
 from urdf_helpers import EXAMPLE_ROBOTS, robot_id, urdf_text
 
-from thorvald_model.joint_tree import UrdfError
+from thorvald_model.errors import UrdfError
 from thorvald_model.mass_properties import mass_properties
 
 INERTIA = '<inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/>'

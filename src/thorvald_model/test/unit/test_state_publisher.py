@@ -6,7 +6,8 @@ import sys
 
 import pytest
 
-from thorvald_model.state_publisher import StatePublisherError, command, joint_states_topic, robot_namespace
+from thorvald_model.errors import StatePublisherError
+from thorvald_model.state_publisher import command, joint_states_topic, robot_namespace
 
 RSP = "/usr/lib/robot_state_publisher/robot_state_publisher"
 

@@ -12,9 +12,8 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from thorvald_model import ConfigError
-from thorvald_model.errors import MISSING
+from thorvald_model.errors import MISSING, UrdfCheckError
 from thorvald_model.urdf_check import (
-    UrdfCheckError,
     checked_urdf,
     closest_names,
     normalize_document,

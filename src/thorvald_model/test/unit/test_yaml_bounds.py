@@ -14,14 +14,13 @@ from model_test_helpers import EXAMPLE_ROBOTS, four_drives
 
 from thorvald_model import ConfigError, load_robot_config, parse_robot_config
 from thorvald_model.datum import load_datum
-from thorvald_model.errors import Problem
+from thorvald_model.errors import Problem, YamlBoundError
 from thorvald_model.schema import (
     MAX_YAML_DEPTH,
     MAX_YAML_INT,
     MAX_YAML_NODES,
     BoundedCLoader,
     BoundedLoader,
-    YamlBoundError,
     load_yaml,
     read_yaml_file,
     short,

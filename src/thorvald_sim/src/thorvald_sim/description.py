@@ -19,12 +19,11 @@ from types import SimpleNamespace
 from typing import Callable, Dict, Iterable, List, Mapping, Optional, Tuple
 
 from thorvald_model.datum import Datum, parse_datum
-from thorvald_model.errors import ConfigError
+from thorvald_model.errors import ConfigError, UrdfError
 from thorvald_model.joint_tree import (  # noqa: F401  (Origin: for the sensors)
     IDENTITY_TRANSFORM,
     Origin,
     ParentJoint,
-    UrdfError,
     compose,
     quaternion_from_rpy,
     rotate,

@@ -10,7 +10,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from thorvald_model.urdf_check import UrdfCheckError
+from thorvald_model.errors import UrdfCheckError
 
 from .as_built import SimAsBuilt
 from .bullet import pybullet as p
