@@ -2,9 +2,12 @@
 refuses with a message that says why (the node catches it at the top, logs it and exits non-zero;
 a service answers with its text).
 
-The classes are also importable from the modules that raise them (``thorvald_sim.simulation``'s
-SpawnError, ``thorvald_sim.description``'s DescriptionError, ...), where code written before this
-module imports them.
+Every exception class of the package is here. Those that were a built-in class before they joined
+this module (a ValueError, a RuntimeError) still are, for code that catches that. The first ones are
+also importable from the modules that raise them (``thorvald_sim.simulation``'s SpawnError,
+``thorvald_sim.description``'s DescriptionError, ...), where code written before this module imports
+them; :class:`SensorKindError` from the kinds' registry, :mod:`thorvald_sim.sensor_kinds`, where a
+kind from outside is registered.
 """
 
 
@@ -46,3 +49,36 @@ class ModelError(SpawnError):
         self.source = source
         self.path = path
         self.rule = rule
+
+
+class WorkerError(ThorvaldSimError, RuntimeError):
+    """A physics worker (:mod:`thorvald_sim.workers`) that could not start, or failed a request other
+    than a spawn's refusal (its text)."""
+
+
+class SpawnInputError(ThorvaldSimError):
+    """spawn_robot's or spawn_model's model text cannot be sent (:mod:`thorvald_sim.spawn_args`): the
+    message says why (file, parameter, XML), in gazebo_ros's words where it has them."""
+
+
+class SpawnFailed(ThorvaldSimError):
+    """What went wrong in spawn_robot or spawn_model after the arguments were taken: no simulator
+    answers, or it refused (exit status 1)."""
+
+
+class MeshReadError(ThorvaldSimError, ValueError):
+    """A mesh file that cannot be read (:mod:`thorvald_sim.models.meshes`); the message says why."""
+
+
+class MalformedTf(ThorvaldSimError, ValueError):
+    """Bytes that are not a serialised tf2_msgs/TFMessage (:mod:`thorvald_sim.tf_watch`)."""
+
+
+class SensorKindError(ThorvaldSimError, ValueError):
+    """A sensor kind that is not whole (a programming error, raised when the kind is made or
+    registered: :mod:`thorvald_sim.sensor_kinds`)."""
+
+
+class NotSimulated(ThorvaldSimError):
+    """A Gazebo sensor block no sensor kind reads: :func:`thorvald_sim.sensor_blocks.read_sensor_blocks`
+    lists it as unsupported; it never leaves that function."""

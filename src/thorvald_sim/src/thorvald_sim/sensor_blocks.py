@@ -49,7 +49,7 @@ from typing import List, Tuple, Union
 
 from thorvald_model.urdf_check import normalize_frame
 
-from .errors import BlockError
+from .errors import BlockError, NotSimulated
 from .sensor_kinds import kind_of_model_plugin, kind_of_sensor
 from .sensor_kinds.block import (
     FRAME_AS_IS,
@@ -104,11 +104,7 @@ def _sensor(element: ET.Element, link: str, root: ET.Element) -> SensorSpec:
             plugin_element = Element(plugin, f"{sensor.path}/plugin[@filename='{filename}']")
             return kind.read_sensor(Found(sensor, plugin_element, link, name, filename, rate, root))
     what = ", ".join(p.get("filename", "?") for p in plugins) or "no plugin"
-    raise _NotSimulated(f"sensor {sensor_type} {name!r} ({what})")
-
-
-class _NotSimulated(Exception):
-    pass
+    raise NotSimulated(f"sensor {sensor_type} {name!r} ({what})")
 
 
 # Model plugins the simulator implements itself (thorvald's) or that mean nothing to it
@@ -138,7 +134,7 @@ def read_sensor_blocks(xml: Union[str, ET.Element]) -> SensorBlocks:
                     continue
                 try:
                     sensors.append(_sensor(element, link, root))
-                except _NotSimulated as e:
+                except NotSimulated as e:
                     unsupported.append(Unsupported(str(e), link))
                 except BlockError as e:
                     refused.append(Refused(link, e.path, e.rule))

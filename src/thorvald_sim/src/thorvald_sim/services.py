@@ -19,12 +19,11 @@ from thorvald_msgs.srv import (
 )
 
 from .as_built import SimAsBuilt
-from .errors import SpawnError
+from .errors import SpawnError, WorkerError
 from .gazebo.frames import euler_of
 from .robot import Pose2D
 from .robot_io import RobotIO
 from .simulation import Camera, save_png
-from .workers import WorkerError
 
 
 class SimulatorServices:

@@ -39,7 +39,7 @@ from thorvald_model.datum import load_datum
 
 from .bullet import pybullet as p
 from .engine import LocalPhysics, WorldSettings
-from .errors import ParameterError
+from .errors import ParameterError, WorkerError
 from .gazebo.api import GazeboApi
 from .lockstep import Lockstep
 from .pacing import FollowerWait, Pacer
@@ -47,7 +47,7 @@ from .params import SimulatorParams
 from .robot_io import WARN_PERIOD, TfWatcher
 from .services import SimulatorServices
 from .simulation import PerformanceMeter, simulator_statuses
-from .workers import WorkerError, WorkerPool
+from .workers import WorkerPool
 from .world import load_world, resolve_world
 
 EXIT_REFUSED = 1

@@ -45,6 +45,7 @@ import xml.etree.ElementTree as ET
 from typing import List, Optional, Sequence, Tuple
 from urllib.parse import SplitResult, urlsplit
 
+from .errors import SpawnInputError
 from .spawn_names import model_name_problem, namespace_problem
 
 SPAWN_MODEL = "spawn_model"
@@ -67,10 +68,6 @@ WORLD_FRAMES = ("", "world", "map")  # Gazebo's names of the world frame
 # this workspace's arguments that only the simulator's ~spawn_robot takes (dest: the value when not given)
 ROBOT_ONLY = {"simulator": None, "command_topic": "", "publish_tf": -1, "as_built": "", "robot_model": ""}
 DEFAULT_SIMULATOR = "/simulator"
-
-
-class SpawnInputError(Exception):
-    """The model's text cannot be sent: the message says why (file, parameter, XML)."""
 
 
 def _checked(problem_of):
@@ -320,7 +317,6 @@ __all__ = [
     "ROBOT",
     "SPAWN_MODEL",
     "SPAWN_ROBOT",
-    "SpawnInputError",
     "build_parser",
     "database_text",
     "package_to_model",

@@ -31,10 +31,10 @@ from thorvald_model import ConfigError, load_robot_config
 from thorvald_msgs.srv import DeleteRobot, SpawnRobot
 
 from .as_built import as_built_for, for_simulator
+from .errors import SpawnFailed, SpawnInputError
 from .spawn_args import (
     ROBOT,
     SPAWN_ROBOT,
-    SpawnInputError,
     database_text,
     joint_lists,
     prepared_xml,
@@ -46,10 +46,6 @@ from .spawn_args import (
 from .spawn_args import parse_args as _parse_args
 
 __all__ = ["main", "parse_args", "read_as_built", "read_description"]
-
-
-class SpawnFailed(Exception):
-    """What went wrong after the arguments were taken (exit status 1)."""
 
 
 def parse_args(argv: List[str], prog: str = SPAWN_ROBOT):

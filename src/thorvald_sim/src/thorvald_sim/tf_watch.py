@@ -21,16 +21,14 @@ import threading
 from dataclasses import dataclass
 from typing import Dict, Iterable, List, Set, Tuple
 
+from .errors import MalformedTf
+
 JUDGE_AFTER = 20  # messages of a publisher read before it is known not to publish a watched transform
 STALE = 2.0  # [s] without the other publisher's transform before the simulator publishes it again
 
 _UINT32 = struct.Struct("<I")
 _STAMP = 12  # bytes of a header's seq, secs and nsecs
 _TRANSFORM = 56  # bytes of a Transform: 7 float64
-
-
-class MalformedTf(ValueError):
-    """Bytes that are not a serialised tf2_msgs/TFMessage."""
 
 
 def tf_frame(name: str) -> str:

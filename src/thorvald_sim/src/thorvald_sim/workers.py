@@ -55,7 +55,7 @@ from multiprocessing.connection import Connection, wait
 from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
 from .engine import NOTHING, Engine, Reads, RobotProxy, WorldSettings, queued_and_asked, took
-from .errors import SpawnError
+from .errors import SpawnError, WorkerError
 from .params import MAX_WORKERS
 from .robot import Pose2D
 from .simulation import Camera
@@ -64,10 +64,6 @@ REPLY_TIMEOUT = 5.0  # [s] wall: a worker that has not answered a step in this l
 START_TIMEOUT = 60.0  # [s] wall: a worker's interpreter, pybullet and the world's scene, on a busy machine
 REQUEST_TIMEOUT = 60.0  # [s] wall: a spawn (meshes to load), a reset, a snapshot (a large image to draw)
 PROXIMITY_MARGIN = 0.5  # [m] beyond two robots' footprint radii: closer than that on two workers is warned
-
-
-class WorkerError(RuntimeError):
-    """A worker that could not start, or failed a request other than a spawn's refusal (its text)."""
 
 
 class WorkerDeath(NamedTuple):
@@ -490,7 +486,6 @@ __all__ = [
     "REQUEST_TIMEOUT",
     "TooClose",
     "WorkerDeath",
-    "WorkerError",
     "WorkerPool",
     "serve",
 ]

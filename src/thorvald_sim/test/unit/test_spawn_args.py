@@ -8,13 +8,13 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from thorvald_sim import spawn_args
+from thorvald_sim.errors import SpawnInputError
 from thorvald_sim.spawn_args import (
     GAZEBO,
     MODEL_DATABASE_TEMPLATE,
     ROBOT,
     SPAWN_MODEL,
     SPAWN_ROBOT,
-    SpawnInputError,
     package_to_model,
     parse_args,
     prepared_xml,

@@ -10,7 +10,8 @@ import pytest
 from geometry_msgs.msg import TransformStamped
 from tf2_msgs.msg import TFMessage
 
-from thorvald_sim.tf_watch import MalformedTf, TfWatch, transform_frames
+from thorvald_sim.errors import MalformedTf
+from thorvald_sim.tf_watch import TfWatch, transform_frames
 
 
 def tf_bytes(*pairs, x=0.25):

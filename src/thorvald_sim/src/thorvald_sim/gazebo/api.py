@@ -68,9 +68,8 @@ from gazebo_msgs.srv import (
 from thorvald_base.publishing import NonBlockingPublisher
 from thorvald_base.rate_grid import RateGrid
 
-from ..errors import SpawnError
+from ..errors import SpawnError, WorkerError
 from ..robot import Pose2D
-from ..workers import WorkerError
 from . import frames
 from .bodies import MODEL_FRAME, STATES_LINKS, STATES_MODELS, Job
 from .entities import GROUND, GROUND_KIND, MODEL, ROBOT, WORLD, Entities, Entity, Joint, Link, Model

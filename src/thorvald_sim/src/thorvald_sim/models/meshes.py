@@ -25,14 +25,12 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
+from ..errors import MeshReadError
+
 MAX_TRIANGLES = 2_000_000  # of one mesh file read here
 
 STL_HEADER = 80
 STL_TRIANGLE = 50
-
-
-class MeshReadError(ValueError):
-    """A mesh file that cannot be read; the message says why."""
 
 
 def is_ascii_stl(path: str) -> bool:

@@ -15,7 +15,7 @@ import os
 import xml.etree.ElementTree as ET
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
-from ..errors import ModelError
+from ..errors import MeshReadError, ModelError
 from ..mesh_check import mesh_problem
 
 # ---- the limits of one model (a spawned model, or one model of a world) ---------------------------
@@ -200,7 +200,7 @@ def _mesh_problem(path: str) -> Optional[str]:
     if extension == ".dae" or (extension == ".stl" and meshes.is_ascii_stl(path)):
         try:
             meshes.read_triangles(path)
-        except meshes.MeshReadError as e:
+        except MeshReadError as e:
             return str(e)
         return None
     return mesh_problem(path)

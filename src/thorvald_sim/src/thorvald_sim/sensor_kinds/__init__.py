@@ -17,8 +17,9 @@ when it is made; two kinds claiming one block, when they are registered.
 from contextlib import contextmanager
 from typing import Iterator, List, Optional, Sequence, Tuple
 
+from ..errors import SensorKindError
 from . import bumper, camera, gnss, imu, lidar, p3d
-from .kind import SensorKind, SensorKindError
+from .kind import SensorKind
 
 BUILT_IN: Tuple[SensorKind, ...] = (
     lidar.LASER,

@@ -27,12 +27,10 @@ import re
 from dataclasses import dataclass, field
 from typing import Callable, Mapping, Optional, Tuple
 
+from ..errors import SensorKindError
+
 MESSAGE_TYPE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*/[A-Za-z][A-Za-z0-9_]*$")
 NAME = re.compile(r"^[a-z][a-z0-9_]*$")
-
-
-class SensorKindError(ValueError):
-    """A kind that is not whole (a programming error, raised when the kind is made or registered)."""
 
 
 @dataclass(frozen=True)
