@@ -1,32 +1,12 @@
-"""thorvald_bringup's errors: one hierarchy in errors.py, the old name importable where it was, and
-odometry_report printing each of them as one line with exit status 2."""
-
-import os
+"""thorvald_bringup's errors: one hierarchy in errors.py (every exception class of the package there:
+tests/test_errors.py), the old name importable where it was, and odometry_report printing each of
+them as one line with exit status 2."""
 
 import pytest
 
 from thorvald_bringup import errors
 from thorvald_bringup.odometry_report import manoeuvre_start
 from thorvald_bringup.odometry_report_cli import main
-from thorvald_testing.sources import exception_classes
-
-SOURCES = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "src", "thorvald_bringup"))
-
-
-def test_every_exception_of_the_package_is_in_errors_py():
-    elsewhere = {}
-    for name in sorted(os.listdir(SOURCES)):
-        if name.endswith(".py") and name != "errors.py":
-            classes = exception_classes(os.path.join(SOURCES, name))
-            if classes:
-                elsewhere[name] = sorted(classes)
-    assert elsewhere == {}
-    assert exception_classes(os.path.join(SOURCES, "errors.py")) == {
-        "ThorvaldBringupError",
-        "ReportError",
-        "UnknownRobot",
-        "DriveError",
-    }
 
 
 def test_one_base_class_and_the_old_name_where_it_was():

@@ -1,6 +1,7 @@
-"""thorvald_design's errors: one tree in errors.py (every exception class of the package there), what
-each part of the package refuses raised as its class with its message as before, no bare ValueError
-left to reach a user, and the command ending on the package's error with one line and exit 2."""
+"""thorvald_design's errors: one tree in errors.py (every exception class of the package there:
+tests/test_errors.py), what each part of the package refuses raised as its class with its message as
+before, no bare ValueError left to reach a user, and the command ending on the package's error with
+one line and exit 2."""
 
 import ast
 import os
@@ -19,7 +20,6 @@ from thorvald_design.study import Space
 from thorvald_model import load_robot_config
 from thorvald_model.description import package_file
 from thorvald_model.errors import ConfigError
-from thorvald_testing.sources import exception_classes
 
 SOURCES = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "src", "thorvald_design"))
 TREE = {
@@ -40,17 +40,6 @@ def sources():
         for name in sorted(files):
             if name.endswith(".py"):
                 yield os.path.join(folder, name)
-
-
-def test_every_exception_of_the_package_is_in_errors_py():
-    elsewhere = {}
-    for path in sources():
-        if path != os.path.join(SOURCES, "errors.py"):
-            classes = exception_classes(path)
-            if classes:
-                elsewhere[os.path.relpath(path, SOURCES)] = sorted(classes)
-    assert elsewhere == {}
-    assert exception_classes(os.path.join(SOURCES, "errors.py")) == TREE
 
 
 def test_one_base_class_each_a_value_error_and_a_study_error_a_config_error():

@@ -1,22 +1,86 @@
 """What the tests read from a package's source files without importing them (pure: the ast module)."""
 
 import ast
-from typing import List, Set
+import builtins
+import re
+from typing import Dict, Iterable, List, Set, Tuple
+
+# Python's own exception classes, by name (ValueError, BaseException, KeyboardInterrupt, ...)
+BUILT_IN_EXCEPTIONS = frozenset(
+    name for name, value in vars(builtins).items() if isinstance(value, type) and issubclass(value, BaseException)
+)
+_EXCEPTION_ENDINGS = ("Error", "Exception", "Warning")  # other packages' classes: yaml.MarkedYAMLError, ...
+# a class statement's head and what its parentheses hold: a file none of whose heads names an exception
+# class among its words is not parsed (most files are not: parsing every file of the workspace is slow)
+_CLASS_HEAD = re.compile(r"^[ \t]*class[ \t]+(\w+)[ \t]*\((.*?)\)[ \t]*:", re.M | re.S)
 
 
-def exception_classes(path: str) -> Set[str]:
-    """Names of the classes a source file defines that derive from an exception class (a base named
-    Exception or ending in Error, or one of the file's own such classes): what each package's test of
-    its one errors module looks for elsewhere."""
-    with open(path, encoding="utf-8") as f:
-        tree = ast.parse(f.read(), path)
-    found: Set[str] = set()
-    for node in ast.walk(tree):
+def _is_exception_base(name: str, known: Set[str]) -> bool:
+    return name in known or name.endswith(_EXCEPTION_ENDINGS)
+
+
+def _classes(text: str, path: str) -> List[Tuple[str, Set[str]]]:
+    """Each class the source defines (at any depth), with the names of its bases (``b`` of ``a.b``),
+    in the order they are defined."""
+    found = []
+    stack = list(reversed(ast.parse(text, path).body))
+    while stack:
+        node = stack.pop()
         if isinstance(node, ast.ClassDef):
-            bases = {b.attr if isinstance(b, ast.Attribute) else getattr(b, "id", "") for b in node.bases}
-            if any(b == "Exception" or b.endswith("Error") or b in found for b in bases):
-                found.add(node.name)
+            found.append(
+                (node.name, {b.attr if isinstance(b, ast.Attribute) else getattr(b, "id", "") for b in node.bases})
+            )
+        for field in ("body", "orelse", "finalbody", "handlers"):  # statements only: a class is one
+            stack += reversed([n for n in getattr(node, field, ()) if isinstance(n, ast.AST)])
     return found
+
+
+def _derived(classes: List[Tuple[str, Set[str]]], known: Set[str]) -> Set[str]:
+    found: Set[str] = set()
+    for name, bases in classes:  # in order: a base of the file's own comes first
+        if any(b in found or _is_exception_base(b, known) for b in bases):
+            found.add(name)
+    return found
+
+
+def exception_classes(path: str, known: Iterable[str] = ()) -> Set[str]:
+    """Names of the classes a source file defines that derive from an exception class: a base that is
+    one of Python's own, a name ending in Error, Exception or Warning, one of ``known`` (exception
+    classes defined elsewhere, e.g. ``SpawnFailed`` imported from an errors module), or one of the
+    file's own such classes."""
+    with open(path, encoding="utf-8") as f:
+        return _derived(_classes(f.read(), path), set(known) | BUILT_IN_EXCEPTIONS)
+
+
+def exception_classes_of(paths: Iterable[str]) -> Dict[str, Set[str]]:
+    """:func:`exception_classes` of each file, every file's classes known to the others (a class
+    deriving from one of another file is found, however far down): what the workspace's errors test
+    (tests/test_errors.py) looks for outside each package's errors module. The class heads are read
+    first, by their words, and only the files whose heads may name an exception class are parsed."""
+    texts = {}
+    for path in paths:
+        with open(path, encoding="utf-8") as f:
+            texts[path] = f.read()
+    heads = [
+        (path, m.group(1), re.findall(r"\w+", m.group(2))) for path in texts for m in _CLASS_HEAD.finditer(texts[path])
+    ]
+    known: Set[str] = set(BUILT_IN_EXCEPTIONS)
+    maybe: Set[Tuple[str, str]] = set()
+    while True:  # every head whose words name a (maybe) exception class: more than are, never fewer
+        more = {(path, name) for path, name, words in heads if any(_is_exception_base(w, known) for w in words)}
+        if more <= maybe:
+            break
+        maybe |= more
+        known |= {name for _, name in more}
+    parsed = {path for path, _ in maybe}
+    classes = {path: _classes(texts[path], path) if path in parsed else [] for path in texts}
+    known = set(BUILT_IN_EXCEPTIONS)
+    while True:
+        found = {path: _derived(c, known) for path, c in classes.items()}
+        names = set().union(*found.values())
+        if names <= known:
+            return found
+        known |= names
 
 
 def imported_names(path: str, module: str) -> List[str]:
