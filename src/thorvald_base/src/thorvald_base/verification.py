@@ -38,7 +38,7 @@ def plan_for(config: RobotConfig) -> Tuple[str, List[Segment]]:
     return "a stadium twice: straights and half circles about its axle line", _stadium(axle)
 
 
-MANOEUVRES = ("verification", "calibration", "field", "balance", "straight", "turns", "heading")
+MANOEUVRES = ("verification", "calibration", "field", "balance", "straight", "turns", "heading", "paper")
 ROWS, ROW_LENGTH, ROW_SPACING = 5, 15.0, 1.5  # the field route: every second row of 0.75 m rows
 TURN_SIGNS = (1.0, 1.0, -1.0, -1.0, 1.0, 1.0, -1.0, -1.0)  # the turns manoeuvre's U turns: two loops each way
 SIDE = 4.0  # [m] of the calibration drive's square (UMBmark's 4 m)
@@ -74,6 +74,8 @@ def plan_named(name: str, config: RobotConfig, side: float = SIDE) -> Tuple[str,
             f"a field route: {ROWS} rows of {ROW_LENGTH:g} m, {ROW_SPACING:g} m apart, joined by headland U turns",
             _field_route(config),
         )
+    if name == "paper":
+        return _paper(config)
     if name not in ("calibration", "balance", "straight", "turns", "heading"):
         raise ValueError(f"manoeuvre must be one of {', '.join(MANOEUVRES)}, not {name!r}")
     if not (side > 0.0 and math.isfinite(side)):
@@ -319,6 +321,55 @@ def _omnidirectional() -> List[Segment]:
         Segment(Twist(0.0, SPEED, -w), circle, "circle right driving sideways, 20 m"),
     ]
     return _with_pauses(legs)
+
+
+def _paper(config: RobotConfig) -> Tuple[str, List[Segment]]:
+    """A validation drive like the paper's (section 3.3.2: 80 m translating in x and y and rotating about
+    z, ending where it started), with spins on the spot both ways between its legs: each leg starts from
+    wheels steered for another motion, as a robot working among rows re-steers. A robot whose wheels
+    cannot all steer cannot crab: it drives straight out and back with a half turn on the spot about its
+    axle line at each end, twice, then the stadium once."""
+    spin = SPEED / 1.0  # [rad/s], as the calibration drive's spins
+    turn = 2.0 * math.pi / spin
+    axle, _ = common_axle(config.drives, config.passive_wheels)
+    if axle is None:
+        circle = 20.0  # [s]: a circle of 20 m at 1 m/s
+        w = 2.0 * math.pi / circle
+        legs = [
+            Segment(Twist(SPEED, 0.0, 0.0), 10.0, "forward 10 m"),
+            Segment(Twist(0.0, 0.0, spin), turn, "spin left, a full turn"),
+            Segment(Twist(0.0, SPEED, 0.0), 10.0, "crab left 10 m"),
+            Segment(Twist(0.0, 0.0, -spin), turn, "spin right, a full turn"),
+            Segment(Twist(-SPEED, 0.0, 0.0), 10.0, "backward 10 m"),
+            Segment(Twist(0.0, 0.0, spin), turn / 2.0, "spin left, a half turn"),
+            Segment(Twist(0.0, SPEED, 0.0), 10.0, "crab left 10 m"),
+            Segment(Twist(0.0, 0.0, -spin), turn / 2.0, "spin right, a half turn"),
+            Segment(Twist(SPEED, 0.0, w), circle, "circle left, 20 m"),
+            Segment(Twist(0.0, SPEED, -w), circle, "circle right driving sideways, 20 m"),
+        ]
+        return (
+            "paper-like: translation in x and y (crab legs), spins on the spot both ways between them, a circle "
+            "and a circle crabbing: 80 m and three turns on the spot, ending at the start",
+            _with_pauses(legs),
+        )
+    dx, dy = _leftwards(axle)
+    nx, ny = dy, -dx
+    foot = -(axle.x * dx + axle.y * dy)
+    cx, cy = axle.x + foot * dx, axle.y + foot * dy  # the axle line's point nearest base_link: spun about
+    fastest = max((spin * math.hypot(d.x - cx, d.y - cy) / d.max_wheel_speed for d in config.drives), default=0.0)
+    w = spin / max(1.0, fastest / TURN_SHARE)
+    legs = [
+        Segment(Twist(SPEED * nx, SPEED * ny, 0.0), 10.0, "straight 10 m"),
+        Segment(Twist(w * cy, -w * cx, w), math.pi / w, "spin left, a half turn"),
+        Segment(Twist(SPEED * nx, SPEED * ny, 0.0), 10.0, "straight 10 m back"),
+        Segment(Twist(-w * cy, w * cx, -w), math.pi / w, "spin right, a half turn"),
+    ]
+    stadium = _stadium(axle)
+    return (
+        "paper-like for a robot that cannot crab: straight 10 m out and back with a half turn on the spot at "
+        "each end, twice, then a stadium once (straights and half circles about its axle line)",
+        _with_pauses(legs + legs) + stadium[:4] + stadium[-1:],
+    )
 
 
 def _stadium(axle) -> List[Segment]:

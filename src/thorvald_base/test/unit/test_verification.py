@@ -134,7 +134,7 @@ def test_a_manoeuvre_of_another_name_or_a_bad_side_is_refused():
     config = four_ws()
     with pytest.raises(
         ValueError,
-        match="one of verification, calibration, field, balance, straight, turns, heading, not 'umbmark'",
+        match="one of verification, calibration, field, balance, straight, turns, heading, paper, not 'umbmark'",
     ):
         plan_named("umbmark", config)
     with pytest.raises(ValueError, match="side must be a positive length"):
@@ -216,3 +216,33 @@ def test_the_straight_drive_is_legs_on_one_line_with_stops_every_wheel_straight(
         for cmd in result.commands:  # every wheel straight, at the working speed
             assert abs(math.remainder(cmd.steering, math.pi)) < 1e-9
             assert abs(cmd.speed) == pytest.approx(SPEED)
+
+
+@pytest.mark.parametrize("path", EXAMPLE_ROBOTS, ids=lambda p: os.path.basename(p)[:-5])
+def test_the_paper_like_manoeuvre_spins_on_the_spot_crabs_where_it_can_and_ends_at_the_start(path):
+    """The bench's second validation drive (bench/calibration_heading.py): the paper's 80 m of translation,
+    with spins on the spot between the legs; a robot that cannot crab spins about its axle line."""
+    config = load_robot_config(path)
+    calc = load_calculator(config)
+    description, plan = plan_named("paper", config)
+    end, dist = commanded_path(plan)
+    assert math.hypot(end.x, end.y) < 1e-6 and abs(math.remainder(end.yaw, 2 * math.pi)) < 1e-6
+    for seg in plan:
+        result = calc.calculate_command(seg.twist)
+        assert not result.changed, (seg.label, result.twist)
+        for cmd, d in zip(result.commands, config.drives):
+            assert abs(cmd.speed) <= d.max_wheel_speed, (seg.label, d.name)
+    spins = [s for s in plan if s.label.startswith("spin")]
+    turned = sum(abs(s.twist.wz) * s.duration for s in spins)
+    axle, _ = common_axle(config.drives, config.passive_wheels)
+    if axle is None:
+        # forward, crab left, backward, crab left again (half turned): 40 m, and two 20 m circles
+        assert dist == pytest.approx(80.0, abs=0.01) and description.startswith("paper-like: translation in x and y")
+        assert any(s.twist.vy and not s.twist.vx and not s.twist.wz for s in plan)  # crab legs
+        assert turned == pytest.approx(3 * 2 * math.pi)  # two full turns and two half turns on the spot
+        assert all(s.twist.vx == 0.0 and s.twist.vy == 0.0 for s in spins)
+    else:
+        # the spins turn about the axle line's point nearest base_link: no wheel of the axle rolls sideways
+        assert description.startswith("paper-like for a robot that cannot crab")
+        assert turned == pytest.approx(4 * math.pi) and 75.0 < dist < 90.0
+        assert not any(s.twist.vy and not s.twist.vx and not s.twist.wz for s in plan)
