@@ -2,7 +2,7 @@
 """The /gazebo API's costs: spawning a small static SDF model, /gazebo/model_states with 20 robots,
 and refusing a model of 10^6 links.
 
-    python bench/gazebo_api.py [--port PORT] [--robots 20] [--spawns 30] [--window 2] [--pairs 8]
+    python bench/gazebo_api.py [--port PORT] [--robots 20] [--spawns 30] [--window 2] [--pairs 8] [--states-rate 50]
 
 Starts its own roscore and the simulator (flat world, real-time factor 0: as fast as it can, no
 /diagnostics), spawns the standard robot --robots times through /gazebo/spawn_urdf_model (each in
@@ -90,12 +90,12 @@ def main(argv=None) -> int:
     parser.add_argument("--spawns", type=int, default=30)
     parser.add_argument("--window", type=float, default=2.0)
     parser.add_argument("--pairs", type=int, default=8)
+    parser.add_argument("--states-rate", type=float, default=50.0, help="the simulator's ~gazebo_states_rate [Hz]")
     args = parser.parse_args(argv)
     with ros_session("gazebo_api_bench", port=args.port) as (_master, procs):
         rospy.set_param("/use_sim_time", True)
-        sim = procs.start(
-            ["rosrun", "thorvald_sim", "simulator", "_world:=flat", "_real_time_factor:=0", "_diagnostics_rate:=0"]
-        )
+        simulator = ["rosrun", "thorvald_sim", "simulator", "_world:=flat", "_real_time_factor:=0"]
+        sim = procs.start([*simulator, "_diagnostics_rate:=0", f"_gazebo_states_rate:={args.states_rate}"])
         rospy.wait_for_service("/gazebo/spawn_urdf_model", 120)
         spawn_urdf = rospy.ServiceProxy("/gazebo/spawn_urdf_model", SpawnModel)
         spawn_sdf = rospy.ServiceProxy("/gazebo/spawn_sdf_model", SpawnModel)
