@@ -44,7 +44,7 @@ from typing import List, Optional, Sequence, Tuple
 import numpy as np
 import rospy
 
-from thorvald_model import ConfigError
+from thorvald_model import ConfigError, with_drive_param
 from thorvald_model.motors import Motor, output_torque, propulsion_motor
 from thorvald_msgs.msg import ControllerArray, DriveParam
 from thorvald_msgs.srv import DriveParams
@@ -71,7 +71,7 @@ class BalanceDrive(VerificationDrive):
         self.calibration = list(self.in_effect.changes)
         config = self.config
         for index, key, value in self.calibration:
-            config = config.with_drive_param(index, key, value)
+            config = with_drive_param(config, index, key, value)
         self.out = str(rospy.get_param("~out", "") or "")
         self.json = str(rospy.get_param("~json", "") or "")
         self.windows: List[BalanceWindow] = balance_legs(self.plan)

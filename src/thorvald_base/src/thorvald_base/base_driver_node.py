@@ -67,7 +67,7 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import BatteryState, JointState
 from std_srvs.srv import SetBool, SetBoolResponse, Trigger, TriggerResponse
 
-from thorvald_model import ConfigError, load_robot_config, parse_robot_config
+from thorvald_model import ConfigError, config_to_dict, load_robot_config, parse_robot_config
 from thorvald_msgs.msg import BaseState, BatteryArray, CANFrame, ControllerArray, DriveCurrents, IOArray
 from thorvald_msgs.srv import (
     CanID,
@@ -199,7 +199,7 @@ class BaseDriverNode:
         # the calibrated configuration is what it drives (set_drive_params may change it later: core.config)
         self.config = self.core.config
         if from_file:
-            for key, value in self.config.to_dict().items():
+            for key, value in config_to_dict(self.config).items():
                 rospy.set_param(names.param(key), value)
         self.lock = threading.Lock()
         self.joint_names = conversions.joint_names(self.config.drives, self.tf_prefix)

@@ -27,7 +27,7 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 import rosbag
 
-from thorvald_model import ConfigError, load_robot_config
+from thorvald_model import ConfigError, load_robot_config, with_drive_param
 
 from .bag_topics import lost_messages, lost_sentence, topics_by_ending
 from .calibration import (
@@ -56,16 +56,12 @@ from .calibration.observable import FAR, along_undetermined
 from .calibration.odometry_error import imu_bias
 from .calibration.turns import TurnFit, turn_fit
 from .conversions import quaternion_yaw
-from .errors import CalibrationError, ThorvaldBaseError
+from .errors import BagError, CalibrationError, ThorvaldBaseError
 from .kinematics.calculator import NO_CORRECTION
 
 ENDINGS = {"states": "base_state", "truth": "odometry/gazebo", "fix": "gps/fix", "imu": "imu/data"}
 EXIT_ERROR = 2
 NO_FIX = -1  # sensor_msgs/NavSatStatus STATUS_NO_FIX
-
-
-class BagError(ThorvaldBaseError):
-    """The bag cannot be read, or lacks what calibration needs."""
 
 
 def find_topics(bag, path: str) -> Dict[str, str]:
@@ -229,7 +225,7 @@ def run(args) -> int:
         values = read_calibration(args.calibration, robot)
         earlier, odometry = list(values.changes), values.odometry
         for index, key, value in earlier:
-            in_effect = in_effect.with_drive_param(index, key, value)
+            in_effect = with_drive_param(in_effect, index, key, value)
     if args.fit in ("scale", "straight", "turns", "heading") and args.balance:
         raise CalibrationError(
             f"--balance goes with --fit drives or odometry: --fit {args.fit} keeps every radius's share"
@@ -294,7 +290,7 @@ def with_balance(calibration: Calibration, observable: Optional[ObservableFit], 
     crab and arc it started with)."""
     config = robot
     for index, key, value in balanced:
-        config = config.with_drive_param(index, key, value)
+        config = with_drive_param(config, index, key, value)
     radii = [d.r_wheel for d in config.drives]
     toe = {index for index, key, _ in balanced if key == "steering_offset"}
     offsets = [d.steering_offset for d in config.drives] if toe else None

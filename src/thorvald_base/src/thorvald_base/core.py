@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass, field
 from typing import List, Optional, Sequence, Tuple
 
+from thorvald_model import with_drive_param
 from thorvald_model.config import RUNTIME_DRIVE_KEYS, RobotConfig
 
 from .bases import BaseHandle, MeasuredDrive
@@ -128,7 +129,7 @@ class BaseDriverCore:
                 )
                 continue
             try:
-                candidate = config.with_drive_param(index, key, value)
+                candidate = with_drive_param(config, index, key, value)
                 self.calculator.set_params(candidate.drives, candidate.passive_wheels)
             except Exception as e:  # ConfigError or KinematicsError: both say what is wrong
                 problems.append(str(e).replace("\n", " "))

@@ -34,6 +34,10 @@ class CalibrationError(ThorvaldBaseError):
     no parameter); the message says which and why."""
 
 
+class BagError(ThorvaldBaseError):
+    """A recorded bag cannot be read, or lacks what calibration needs (calibrate_odometry)."""
+
+
 class MalformedFrame(ThorvaldBaseError, ValueError):
     """A CAN frame whose length or content does not fit its identifier's layout
     (:mod:`thorvald_base.can.protocol`); the devices count it and go on. Also a ValueError, as it was

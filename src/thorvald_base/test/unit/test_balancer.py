@@ -15,7 +15,7 @@ from thorvald_base.calibration.toe_balance import toe_legs
 from thorvald_base.calibration.torque_balance import MAX_STEP, Leg, relative_errors
 from thorvald_base.errors import CalibrationError
 from thorvald_base.verification import BALANCE_AGAIN, BALANCE_LEGS
-from thorvald_model import ConfigError, load_robot_config, parse_robot_config
+from thorvald_model import ConfigError, load_robot_config, parse_robot_config, with_drive_param
 
 ASYM = next(p for p in EXAMPLE_ROBOTS if p.endswith("thorvald_ii_6wd6ws_asym.yaml"))
 SPEED = 0.2  # [m/s]
@@ -105,7 +105,7 @@ def test_nothing_the_robot_files_rules_refuse_is_sent():
     assert "the robot file's rules refuse what the balance would set" in balancer.stopped
     for radii in driven:  # everything driven is what the rules take
         for k, r in enumerate(radii):
-            config.with_drive_param(k, "r_wheel", r)
+            with_drive_param(config, k, "r_wheel", r)
 
 
 def test_a_balance_that_does_not_reduce_the_fight_is_not_kept():

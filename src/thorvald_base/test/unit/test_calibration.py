@@ -25,6 +25,7 @@ from thorvald_base.calibration import (
 )
 from thorvald_base.errors import CalibrationError
 from thorvald_base.kinematics import Twist
+from thorvald_model import with_drive_param
 
 # the field profile's tolerances: radius +-1 %, steering +-0.5 deg
 RADII = (0.2016, 0.1990, 0.2006, 0.1981)  # [m] true rolling radii (configured 0.2)
@@ -70,7 +71,7 @@ def test_every_parameter_recovered_exactly_without_noise(ground_truth):
 def test_the_values_in_effect_are_where_the_estimates_start_from(ground_truth):
     """base_driver read the drive with drive1 at 0.205 m and drive2 homed 0.01 rad off: the estimates
     are still the true values, not corrections to them."""
-    config = four_ws().with_drive_param(1, "r_wheel", 0.205).with_drive_param(2, "steering_offset", 0.01)
+    config = with_drive_param(with_drive_param(four_ws(), 1, "r_wheel", 0.205), 2, "steering_offset", 0.01)
     drive = synthetic_drive(config, MIXED, RADII, OFFSETS, heading_bias=PSI, antenna=ANTENNA)
     calibration = calibrate(config, drive.recording, getattr(drive, ground_truth))
     assert calibration.parameter("drive1", "r_wheel").in_effect == 0.205
@@ -257,7 +258,7 @@ def test_the_calibrated_odometry_follows_ground_truth(ground_truth):
 
 def test_as_read_with_the_calibrated_configuration():
     config = four_ws()
-    calibrated = config.with_drive_param(0, "r_wheel", 0.21).with_drive_param(2, "steering_offset", 0.02)
+    calibrated = with_drive_param(with_drive_param(config, 0, "r_wheel", 0.21), 2, "steering_offset", 0.02)
     recording = DriveRecording(np.array([0.0, 0.02]), np.full((2, 4), 0.1), np.full((2, 4), 0.5))
     read = as_read_with(recording, config, calibrated)
     assert read.speed[0] == pytest.approx([0.5 * 0.21 / 0.2, 0.5, 0.5, 0.5])  # wheel turns x the new radius

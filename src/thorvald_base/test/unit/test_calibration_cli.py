@@ -20,7 +20,7 @@ from thorvald_base.calibration import load_calibration
 from thorvald_base.calibration.recording import WGS84_A, WGS84_E2
 from thorvald_base.calibration_cli import main
 from thorvald_base.kinematics import Twist
-from thorvald_model import load_robot_config
+from thorvald_model import load_robot_config, with_drive_param
 from thorvald_msgs.msg import BaseState
 
 STD = next(p for p in EXAMPLE_ROBOTS if p.endswith("thorvald_ii_4wd4ws_std.yaml"))
@@ -166,7 +166,7 @@ def test_text_with_gnss_on_a_straight_line_refuses_the_offsets(tmp_path, capsys,
 def test_a_calibration_in_effect_is_where_it_starts_and_what_it_keeps(tmp_path, capsys, std):
     earlier = tmp_path / "earlier.yaml"
     earlier.write_text("motor_drives:\n  drive1: {r_wheel: 0.205}\n  drive2: {steering_offset: 0.01}\n")
-    in_effect = std.with_drive_param(1, "r_wheel", 0.205).with_drive_param(2, "steering_offset", 0.01)
+    in_effect = with_drive_param(with_drive_param(std, 1, "r_wheel", 0.205), 2, "steering_offset", 0.01)
     drive = synthetic_drive(in_effect, STRAIGHT, RADII, OFFSETS, heading_bias=0.4)
     bag = write_bag(tmp_path / "d.bag", drive, gnss=True, sim=False)  # a real robot's bag: no simulator
     status, out, err = run(capsys, bag, "--robot-model", STD, "--calibration", earlier, "--json")
@@ -194,7 +194,7 @@ def test_fit_scale_takes_the_radii_common_factor_from_straight_legs_over_the_cal
 
     earlier = tmp_path / "earlier.yaml"
     earlier.write_text("motor_drives:\n  drive1: {r_wheel: 0.205, steering_offset: 0.01}\n")
-    in_effect = std.with_drive_param(1, "r_wheel", 0.205).with_drive_param(1, "steering_offset", 0.01)
+    in_effect = with_drive_param(with_drive_param(std, 1, "r_wheel", 0.205), 1, "steering_offset", 0.01)
     truth = [d.r_wheel * 1.003 for d in in_effect.drives]  # every tyre 0.3 % larger than in effect
     offsets = [d.steering_offset for d in in_effect.drives]
     plan = [(s.duration, s.twist) for s in plan_named("straight", std, side=3.0)[1]]
@@ -257,7 +257,7 @@ def test_fit_turns_takes_the_yaw_rate_multiplier_from_the_turns_over_the_calibra
 
     earlier = tmp_path / "earlier.yaml"
     earlier.write_text("motor_drives:\n  drive1: {r_wheel: 0.205}\nodometry: {yaw_rate_multiplier: 1.002}\n")
-    in_effect = std.with_drive_param(1, "r_wheel", 0.205)
+    in_effect = with_drive_param(std, 1, "r_wheel", 0.205)
     plan = [(s.duration, s.twist) for s in plan_named("turns", std, side=3.0)[1]]
     radii = [d.r_wheel for d in in_effect.drives]
     drive = with_turn_slip(synthetic_drive(in_effect, plan, radii, [0.0] * 4), left=1.005, right=1.005)
@@ -301,7 +301,7 @@ def test_fit_heading_takes_odometrys_heading_model_from_several_drives_over_the_
 
     earlier = tmp_path / "earlier.yaml"
     earlier.write_text("motor_drives:\n  drive1: {r_wheel: 0.205}\nodometry: {yaw_per_metre: 0.0004}\n")
-    in_effect = std.with_drive_param(1, "r_wheel", 0.205)
+    in_effect = with_drive_param(std, 1, "r_wheel", 0.205)
     radii = [d.r_wheel for d in in_effect.drives]
     bags = []
     for name in ("calibration", "turns"):  # two drives with the calibration in effect, turning 0.6 % more

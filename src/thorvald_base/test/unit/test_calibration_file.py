@@ -17,7 +17,7 @@ from thorvald_base.calibration import (
     parse_calibration,
     set_drive_params_command,
 )
-from thorvald_model import ConfigError
+from thorvald_model import ConfigError, with_drive_param
 
 RADII = (0.2016, 0.1990, 0.2006, 0.1981)
 OFFSETS = (0.004, -0.006, 0.002, 0.007)
@@ -45,7 +45,7 @@ def test_written_and_read_back_as_base_driver_reads_it(tmp_path):
     assert [value for _, _, value in changes] == pytest.approx(expected, rel=1e-9)
     # applied as set_drive_params applies it: the calibrated robot
     for i, key, value in changes:
-        config = config.with_drive_param(i, key, value)
+        config = with_drive_param(config, i, key, value)
     assert [d.r_wheel for d in config.drives] == pytest.approx(RADII, rel=1e-9)
 
 

@@ -28,6 +28,7 @@ from thorvald_base.calibration.observable import (
 )
 from thorvald_base.errors import CalibrationError
 from thorvald_base.kinematics import Twist
+from thorvald_model import with_drive_param
 
 RADII = (0.2016, 0.1990, 0.2006, 0.1981)  # [m] true rolling radii (configured 0.2), the field's +-1 %
 OFFSETS = (0.004, -0.006, 0.002, 0.007)  # [rad] true steering offsets (configured 0)
@@ -100,7 +101,7 @@ def test_a_drive_that_turns_crabs_and_spins_determines_all_but_the_frames_diagon
     # what is determined is what the odometry needs: replayed, the calibrated drive is ground truth
     calibrated = config
     for index, key, value in fit.changes():
-        calibrated = calibrated.with_drive_param(index, key, value)
+        calibrated = with_drive_param(calibrated, index, key, value)
     before = odometry_error(config, drive.recording, drive.pose_truth)
     after = odometry_error(calibrated, as_read_with(drive.recording, config, calibrated), drive.pose_truth)
     assert before.end_point_m > 0.1 and after.end_point_m < 1e-6

@@ -9,13 +9,14 @@ from thorvald_base.bases.simulated import SimulatedBase
 from thorvald_base.bases.simulated_joints import SimulatedJointsBase
 from thorvald_base.core import BaseDriverCore
 from thorvald_base.kinematics import DriveCommand, PltfClcStd
+from thorvald_model import with_drive_param
 
 OFFSETS = (0.05, 0.0, -0.03, 0.0)  # [rad] drive0 and drive2 homed off
 
 
 def with_offsets(config, offsets=OFFSETS):
     for k, offset in enumerate(offsets):
-        config = config.with_drive_param(k, "steering_offset", offset)
+        config = with_drive_param(config, k, "steering_offset", offset)
     return config
 
 
@@ -101,7 +102,7 @@ def test_simulated_joints_scale_rim_speeds_by_the_spawn_radius_over_the_radius_n
 
     # drive1 now 0.25 m: the simulator (0.2 m) must turn that wheel at 0.5 / 0.25 = 2 rad/s, which it
     # does for a rim speed of 2 * 0.2 = 0.4 m/s; what it measures at 0.2 m reads 0.25/0.2 larger
-    base.set_params(config.with_drive_param(1, "r_wheel", 0.25))
+    base.set_params(with_drive_param(config, 1, "r_wheel", 0.25))
     base.send_drive_commands([DriveCommand(0.1, 0.5)] * 4, 1.02)
     assert [c.speed for c in sent[-1]] == pytest.approx([0.5, 0.4, 0.5, 0.5], abs=1e-15)
     assert [c.steering for c in sent[-1]] == [0.1] * 4
@@ -120,7 +121,7 @@ def test_simulated_joints_apply_radius_and_offset_together_on_a_differential_rob
     sent = []
     config = diff()  # two type-1 drives: no offset allowed, radius only
     base = SimulatedJointsBase(config, lambda commands, time: sent.append(commands))
-    base.set_params(config.with_drive_param(0, "r_wheel", 0.21))
+    base.set_params(with_drive_param(config, 0, "r_wheel", 0.21))
     base.update([MeasuredDrive(0.0, 0.3, 0.0, 0.0)] * 2, 0.0)
     base.send_drive_commands([DriveCommand(0.0, 0.42), DriveCommand(0.0, 0.42)], 0.0)
     assert [c.speed for c in sent[-1]] == pytest.approx([0.4, 0.42], abs=1e-15)  # 0.42 * 0.2 / 0.21

@@ -13,6 +13,7 @@ from thorvald_base.core import DEFAULT_TWIST_COVARIANCE, BaseDriverCore, PoseCov
 from thorvald_base.errors import ParameterError, ThorvaldBaseError
 from thorvald_base.kinematics import DriveCommand, OdometryResult, PltfClcStd, Pose, Twist
 from thorvald_base.params import DriverParams
+from thorvald_model import with_drive_param
 
 
 class RecordingBase(BaseHandle):
@@ -182,7 +183,7 @@ def test_simulated_joints_reports_the_simulators_motor_currents():
     assert steer[:4] == ("steering", 0.3, 0.1, 0.5) and steer[4] == pytest.approx(0.014 * 0.85)
     assert base.controllers(1.0125)[0].motor_vars[0][3] == 9.0
     # a wheel's radius changed by set_drive_params scales its rim speed, not its current
-    base.set_params(base.config.with_drive_param(0, "r_wheel", 0.2 * 1.002))
+    base.set_params(with_drive_param(base.config, 0, "r_wheel", 0.2 * 1.002))
     assert base.controllers(1.0125)[0].motor_vars[0][1:4] == (pytest.approx(0.5 * 1.002), 2.0, 9.0)
     with pytest.raises(ValueError, match="3 propulsion and 4 steering currents for 4 drives"):
         base.update_currents([1.0] * 3, [0.0] * 4, 1.05)

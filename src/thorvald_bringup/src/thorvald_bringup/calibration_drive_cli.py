@@ -57,7 +57,7 @@ from thorvald_base.calibration.calibration_file import load_calibration
 from thorvald_base.calibration.toe_balance import toe_gauge
 from thorvald_base.calibration.torque_balance import relative_errors
 from thorvald_base.verification import SIDE
-from thorvald_model import ConfigError, load_robot_config
+from thorvald_model import ConfigError, load_robot_config, with_drive_param
 from thorvald_sim.as_built import PROFILES, as_built_for
 
 from .errors import DriveError, ThorvaldBringupError
@@ -333,7 +333,7 @@ def toe_errors(config, built, odometry_changes, balanced) -> dict:
 
     fitted = config
     for index, key, value in odometry_changes:
-        fitted = fitted.with_drive_param(index, key, value)
+        fitted = with_drive_param(fitted, index, key, value)
     start = [d.steering_offset for d in fitted.drives]
     found = list(start)
     for name, values in balanced["toe"]["drives"].items():
@@ -352,7 +352,7 @@ def tyre_errors(config, built, odometry_changes, balanced, final_changes) -> dic
     def radii(changes):
         fitted = config
         for index, key, value in changes:
-            fitted = fitted.with_drive_param(index, key, value)
+            fitted = with_drive_param(fitted, index, key, value)
         return [d.r_wheel for d in fitted.drives]
 
     sets = {

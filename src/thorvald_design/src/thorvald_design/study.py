@@ -50,6 +50,7 @@ import re
 from dataclasses import dataclass
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
+from thorvald_model import config_to_dict
 from thorvald_model.config import parse_robot_config
 from thorvald_model.errors import MISSING, ConfigError, Problem, UnknownRobotError
 from thorvald_model.examples import names_a_file, robot_file
@@ -441,7 +442,7 @@ def as_read(config) -> Dict[str, Any]:
     """The robot file as a study's runs read it: every default filled in and every alias resolved
     (``RobotConfig.to_dict``, which leaves out what the loader drops), less what nothing reads for an
     entry's kind (:data:`UNREAD`). Two combinations of a sweep with the same are the same robot."""
-    out = config.to_dict()
+    out = config_to_dict(config)
     for section, unread, _ in UNREAD:
         for item in getattr(config, _ATTR[section]):
             entry = out[section][item.name]

@@ -30,6 +30,7 @@ from .schema import Kept, check_top_level, parse_section, read_yaml_file
 from .values import (
     ALL_DIMENSIONS,
     FRAME_PART_DIMENSIONS,
+    RAIL_FLANGE_WIDTH,
     Battery,
     Beam,
     Corner,
@@ -177,7 +178,7 @@ def _attach_channels(drives: List[Drive]) -> List[Drive]:
 
 
 def config_to_dict(config: RobotConfig) -> Dict[str, Any]:
-    """The configuration in the file's format, with every default filled in (RobotConfig.to_dict)."""
+    """The configuration in the file's format, with every default filled in."""
     out = {"base_calculator": config.base_calculator}
     for section in SECTIONS:
         items = getattr(config, section.attr)
@@ -186,6 +187,27 @@ def config_to_dict(config: RobotConfig) -> Dict[str, Any]:
     out.update(dict(config.extras))
     for section_key, entry, key, value in config.entry_extras:
         out[section_key][entry][key] = value
+    return out
+
+
+def description_dict(config: RobotConfig) -> Dict[str, Any]:
+    """:func:`config_to_dict` with the derived facts the model's xacro draws by, under ``derived`` of
+    each drive, battery and passive wheel entry (never fed back to the loader)."""
+    out = config_to_dict(config)
+    for d in config.drives:
+        out["motor_drives"][d.name]["derived"] = {
+            "steerable": d.steerable,
+            "max_wheel_torque": d.max_wheel_torque,
+            "max_wheel_rate": d.max_wheel_rate,
+            "max_steering_torque": d.max_steering_torque,
+            "rail_wheel": d.has_rail_wheel,
+            "rail_flange_radius": d.rail_flange_radius,
+            "rail_flange_width": RAIL_FLANGE_WIDTH,
+        }
+    for b in config.batteries:
+        out["batteries"][b.name]["derived"] = {"present": b.present}
+    for w in config.passive_wheels:
+        out["passive_wheels"][w.name]["derived"] = {"caster": not w.fixed}
     return out
 
 
@@ -220,6 +242,7 @@ __all__ = [
     "RobotConfig",
     "Suspension",
     "config_to_dict",
+    "description_dict",
     "load_robot_config",
     "parse_robot_config",
     "with_drive_param",

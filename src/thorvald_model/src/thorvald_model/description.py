@@ -4,7 +4,7 @@
 xacro's ``load_yaml()``. This module runs the real xacro (the ROS 1 flavour, 1.13) with that one
 symbol replaced, so that loading the robot configuration goes through the shared loader
 (:func:`thorvald_model.config.load_robot_config`): the xacro sees the validated configuration
-with every default filled in and every alias resolved (``RobotConfig.to_dict()``), and a broken
+with every default filled in and every alias resolved (``thorvald_model.config_to_dict``), and a broken
 file stops with the loader's list of problems. The xacro never repeats a default or a rule.
 
 Other YAML files (a user's extras loading their sensor table) load with ``yaml.safe_load``, since
@@ -28,7 +28,7 @@ from typing import Any, Callable, Dict, Iterator, Optional
 import xacro
 import yaml
 
-from .config import load_robot_config, parse_robot_config
+from .config import description_dict, load_robot_config, parse_robot_config
 from .datum import load_datum
 from .errors import ConfigError, RobotConfigAbort, UrdfCheckError, XacroError
 from .frames import normalize_tf_prefix
@@ -59,7 +59,7 @@ def _robot_dict(load: Callable[[], Any]) -> Dict[str, Any]:
     """The canonical dict of a robot configuration with its derived facts (description_dict), or
     its ConfigError carried out of xacro."""
     try:
-        return load().description_dict()
+        return description_dict(load())
     except ConfigError as e:
         raise RobotConfigAbort(e) from None
 

@@ -397,35 +397,3 @@ class RobotConfig:
 
     def wheel_contacts(self) -> List[Tuple[float, float]]:
         return [(d.x, d.y) for d in self.drives] + [(w.x, w.y) for w in self.passive_wheels]
-
-    def to_dict(self) -> Dict[str, Any]:
-        """The configuration in the file's format, with every default filled in."""
-        from .config import config_to_dict  # noqa: PLC0415  (the loader knows the file's shape)
-
-        return config_to_dict(self)
-
-    def description_dict(self) -> Dict[str, Any]:
-        """:meth:`to_dict` with the derived facts the model's xacro draws by, under ``derived`` of
-        each drive, battery and passive wheel entry (never fed back to the loader)."""
-        out = self.to_dict()
-        for d in self.drives:
-            out["motor_drives"][d.name]["derived"] = {
-                "steerable": d.steerable,
-                "max_wheel_torque": d.max_wheel_torque,
-                "max_wheel_rate": d.max_wheel_rate,
-                "max_steering_torque": d.max_steering_torque,
-                "rail_wheel": d.has_rail_wheel,
-                "rail_flange_radius": d.rail_flange_radius,
-                "rail_flange_width": RAIL_FLANGE_WIDTH,
-            }
-        for b in self.batteries:
-            out["batteries"][b.name]["derived"] = {"present": b.present}
-        for w in self.passive_wheels:
-            out["passive_wheels"][w.name]["derived"] = {"caster": not w.fixed}
-        return out
-
-    def with_drive_param(self, index: int, key: str, value: Any) -> "RobotConfig":
-        """A copy with ``motor_drives/drive<index>/<key>`` set to value, validated like a file."""
-        from .config import with_drive_param  # noqa: PLC0415  (validating is the loader's job)
-
-        return with_drive_param(self, index, key, value)

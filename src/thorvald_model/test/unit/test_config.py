@@ -7,7 +7,7 @@ import pytest
 import yaml
 from model_test_helpers import EXAMPLE_ROBOTS, FIGURE5, std_drive
 
-from thorvald_model import ConfigError, load_robot_config, parse_robot_config
+from thorvald_model import ConfigError, config_to_dict, load_robot_config, parse_robot_config, with_drive_param
 from thorvald_model.config import STD_CALCULATOR
 
 
@@ -86,7 +86,7 @@ def test_unknown_keys_unlike_ours_are_kept_with_a_warning(robot, caplog):
     source = "kept_keys_robot.yaml"
     with caplog.at_level("WARNING", logger="thorvald_model"):
         config = parse_robot_config(robot, source)
-        parse_robot_config(config.to_dict(), source)  # loaded again: no second warning
+        parse_robot_config(config_to_dict(config), source)  # loaded again: no second warning
     assert [(w.path, w.value) for w in config.warnings] == [
         ("sensor_mast", {"height": 2.1}),
         ("motor_drives.drive1.hub_motor_make", "ACME"),
@@ -94,7 +94,7 @@ def test_unknown_keys_unlike_ours_are_kept_with_a_warning(robot, caplog):
     ]
     assert all("unknown key, kept" in w.rule for w in config.warnings)
     assert sorted(r.getMessage() for r in caplog.records) == sorted(w.format(source) for w in config.warnings)
-    out = config.to_dict()
+    out = config_to_dict(config)
     assert out["sensor_mast"] == {"height": 2.1}
     assert out["motor_drives"]["drive1"]["hub_motor_make"] == "ACME"
     assert out["batteries"]["bat0"]["colour_code"] == 7
@@ -211,9 +211,9 @@ def test_steering_offset_may_change_while_the_robot_runs(robot):
     from thorvald_model.config import RUNTIME_DRIVE_KEYS  # noqa: PLC0415
 
     assert "steering_offset" in RUNTIME_DRIVE_KEYS
-    config = parse_robot_config(robot).with_drive_param(2, "steering_offset", 0.05)
+    config = with_drive_param(parse_robot_config(robot), 2, "steering_offset", 0.05)
     assert config.drives[2].steering_offset == 0.05
-    assert config.to_dict()["motor_drives"]["drive2"]["steering_offset"] == 0.05
+    assert config_to_dict(config)["motor_drives"]["drive2"]["steering_offset"] == 0.05
 
 
 def test_drive_type_is_0_or_1(robot):
@@ -570,15 +570,15 @@ def test_standard_example_robot_is_figure5():
 @pytest.mark.parametrize("path", [*EXAMPLE_ROBOTS, FIGURE5], ids=lambda p: os.path.basename(p)[:-5])
 def test_to_dict_round_trips(path):
     config = load_robot_config(path)
-    again = parse_robot_config(yaml.safe_load(yaml.safe_dump(config.to_dict())), config.source)
+    again = parse_robot_config(yaml.safe_load(yaml.safe_dump(config_to_dict(config))), config.source)
     assert again == config
 
 
 def test_drive_parameter_changed_at_run_time(robot):
     config = parse_robot_config(robot)
-    changed = config.with_drive_param(2, "r_wheel", 0.25)
+    changed = with_drive_param(config, 2, "r_wheel", 0.25)
     assert changed.drives[2].r_wheel == 0.25
     assert config.drives[2].r_wheel == 0.2  # frozen: the original stays as it was
     with pytest.raises(ConfigError) as info:
-        config.with_drive_param(2, "r_wheel", -1)
+        with_drive_param(config, 2, "r_wheel", -1)
     assert info.value.problems[0].path == "motor_drives.drive2.r_wheel"

@@ -11,7 +11,7 @@ import pytest
 import yaml
 from model_test_helpers import PKG, four_drives
 
-from thorvald_model import load_robot_config
+from thorvald_model import config_to_dict, load_robot_config, with_drive_param
 from thorvald_model.config import RUNTIME_DRIVE_KEYS, parse_robot_config
 from thorvald_model.description import generate_urdf
 from thorvald_model.errors import ConfigError, Problem
@@ -94,11 +94,11 @@ def test_r_wheel_may_be_the_rail_wheels_while_it_rides_the_rails():
     """base_driver's set_drive_params validates each change as a file: r_wheel = rail_r_wheel is the
     robot on its rails, and back again the robot on the floor."""
     config = parse_robot_config(railed())
-    on_rails = config.with_drive_param(0, "r_wheel", 0.15)
+    on_rails = with_drive_param(config, 0, "r_wheel", 0.15)
     assert on_rails.drives[0].r_wheel == on_rails.drives[0].rail_r_wheel == 0.15
-    assert on_rails.with_drive_param(0, "r_wheel", 0.2).drives[0].r_wheel == 0.2
+    assert with_drive_param(on_rails, 0, "r_wheel", 0.2).drives[0].r_wheel == 0.2
     with pytest.raises(ConfigError):  # a tyre smaller than its rail wheel is not that state
-        config.with_drive_param(0, "r_wheel", 0.14)
+        with_drive_param(config, 0, "r_wheel", 0.14)
 
 
 @pytest.mark.parametrize("offset", [0.0, 0.05, 0.119, -0.119])
@@ -133,7 +133,7 @@ def test_steered_rail_wheels_must_not_hit_each_other_as_they_turn():
 
 def test_the_rail_keys_round_trip_through_the_files_format():
     config = load_robot_config(GREENHOUSE)
-    again = parse_robot_config(yaml.safe_load(yaml.safe_dump(config.to_dict())), config.source)
+    again = parse_robot_config(yaml.safe_load(yaml.safe_dump(config_to_dict(config))), config.source)
     assert again == config
 
 

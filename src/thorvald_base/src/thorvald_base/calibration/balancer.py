@@ -30,7 +30,7 @@ from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from thorvald_model import ConfigError, RobotConfig
+from thorvald_model import ConfigError, RobotConfig, with_drive_param
 
 from ..errors import CalibrationError
 from .toe_balance import ToeSearch, resistance
@@ -120,9 +120,9 @@ class Balancer:
         config = self.config
         try:
             for k, (r, o) in enumerate(zip(radii, offsets)):
-                config = config.with_drive_param(k, "r_wheel", r)
+                config = with_drive_param(config, k, "r_wheel", r)
                 if config.drives[k].steerable:
-                    config = config.with_drive_param(k, "steering_offset", o)
+                    config = with_drive_param(config, k, "steering_offset", o)
         except ConfigError as e:
             raise CalibrationError(
                 "the robot file's rules refuse what the balance would set: " + str(e).replace("\n", " ")

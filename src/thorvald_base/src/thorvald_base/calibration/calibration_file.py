@@ -28,6 +28,7 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 import yaml
 
+from thorvald_model import with_drive_param
 from thorvald_model.config import RUNTIME_DRIVE_KEYS
 from thorvald_model.errors import MISSING, ConfigError, Problem
 from thorvald_model.keys import DRIVE_KEYS
@@ -216,7 +217,7 @@ def parse_calibration_values(data: Any, config: RobotConfig, source: str = "<cal
     candidate = config
     for index, key, value in changes:
         try:
-            candidate = candidate.with_drive_param(index, key, value)
+            candidate = with_drive_param(candidate, index, key, value)
         except ConfigError as e:
             problems += [p for p in e.problems if p not in problems]
     weights = None if raw_weights is None else _wheel_weights(raw_weights, candidate, problems)

@@ -41,6 +41,7 @@ from typing import Callable, List, Optional, Tuple, Union
 
 import numpy as np
 
+from thorvald_model import with_drive_param
 from thorvald_model.values import RobotConfig
 
 from ..errors import CalibrationError
@@ -174,7 +175,7 @@ def _with_heading(fit: ScaleFit, config, recording, truth, calculator_for) -> Sc
     legs replayed with the radii's factor applied."""
     scaled = config
     for i, drive in enumerate(config.drives):
-        scaled = scaled.with_drive_param(i, "r_wheel", drive.r_wheel * fit.factor)
+        scaled = with_drive_param(scaled, i, "r_wheel", drive.r_wheel * fit.factor)
     legs = _legs(scaled, as_read_with(recording, config, scaled), truth, calculator_for, fit.in_effect)
     used = [leg for leg, first in zip(legs, fit.legs) if first.straight] if len(legs) == len(fit.legs) else []
     if not used:
