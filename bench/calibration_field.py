@@ -41,7 +41,7 @@ def as_built_file(robot: str, seed: int, path: str) -> str:
 
     from thorvald_base.calibration.calibration_file import changes_yaml  # noqa: PLC0415
     from thorvald_model import load_robot_config  # noqa: PLC0415
-    from thorvald_sim.as_built import as_built_for  # noqa: PLC0415
+    from thorvald_sim.physics.as_built import as_built_for  # noqa: PLC0415
 
     model = os.path.join(rospkg.RosPack().get_path("thorvald_model"), "config", robot, f"{robot}.yaml")
     built = as_built_for(f"field:{seed}", load_robot_config(model))

@@ -161,9 +161,9 @@ def raw_pybullet(n: int, physics: str, seconds: float = RAW_SECONDS) -> float:
     simulator's Simulation class."""
     from thorvald_model.description import generate_urdf  # noqa: PLC0415
     from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
-    from thorvald_sim.physics import physics_settings  # noqa: PLC0415
-    from thorvald_sim.robot import Pose2D  # noqa: PLC0415
-    from thorvald_sim.simulation import Simulation  # noqa: PLC0415
+    from thorvald_sim.physics.presets import physics_settings  # noqa: PLC0415
+    from thorvald_sim.physics.robot import Pose2D  # noqa: PLC0415
+    from thorvald_sim.physics.simulation import Simulation  # noqa: PLC0415
     from thorvald_sim.world import load_world, resolve_world  # noqa: PLC0415
 
     settings = physics_settings(physics, None, None)

@@ -26,7 +26,7 @@ import tempfile
 import yaml
 
 from thorvald_model import load_robot_config
-from thorvald_sim.as_built import draw_as_built
+from thorvald_sim.physics.as_built import draw_as_built
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 CONFIGS = os.path.join(ROOT, "src", "thorvald_model", "config")

@@ -9,7 +9,7 @@ the wheels' ramps in Python) and of bare pybullet.stepSimulation, each preset in
 interleaved (the median is printed: this machine is noisy).
 
 What it changes: every example robot drives the paper's verification manoeuvre (about 80 m) on
-tarmac_gravel through the simulator library (thorvald_sim.runner: base_driver's core in lockstep,
+tarmac_gravel through the simulator library (thorvald_sim.tools.runner: base_driver's core in lockstep,
 no ROS), with each preset: odometry's distance error and end point against ground truth, and how far
 the fleet preset's true path strays from the default's (the largest distance at one instant).
 
@@ -29,10 +29,10 @@ from thorvald_base.verification import plan_for
 from thorvald_model import load_robot_config
 from thorvald_model.description import generate_urdf
 from thorvald_sim.bullet import pybullet as p
-from thorvald_sim.physics import PRESETS
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.runner import RunOptions, commands_from_plan, run_robot
-from thorvald_sim.simulation import Simulation
+from thorvald_sim.physics.presets import PRESETS
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation
+from thorvald_sim.tools.runner import RunOptions, commands_from_plan, run_robot
 from thorvald_sim.world import load_world, resolve_world
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))

@@ -31,7 +31,7 @@ import time
 from thorvald_base.verification import plan_for
 from thorvald_model import load_robot_config
 from thorvald_model.description import package_file
-from thorvald_sim.runner import RunOptions, commands_from_plan, run_robot
+from thorvald_sim.tools.runner import RunOptions, commands_from_plan, run_robot
 
 TARGET = 30.0  # simulated seconds per wall second, one robot, one core
 START = 3.0  # [s] the manoeuvre's first command, as verification_drive's in a paused lockstep run

@@ -72,8 +72,8 @@ def raw_costs(wall: float, only=None, stop: Optional[threading.Event] = None, fi
     computed once from the mount's first pose (cameras left out), as this bench measured before."""
     from thorvald_model.description import generate_urdf  # noqa: PLC0415
     from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
-    from thorvald_sim.robot import Pose2D  # noqa: PLC0415
-    from thorvald_sim.simulation import Simulation  # noqa: PLC0415
+    from thorvald_sim.physics.robot import Pose2D  # noqa: PLC0415
+    from thorvald_sim.physics.simulation import Simulation  # noqa: PLC0415
     from thorvald_sim.world import load_world, resolve_world  # noqa: PLC0415
 
     c = p.connect(p.DIRECT)

@@ -54,8 +54,8 @@ def world(n: int):
     """
     from thorvald_model.description import generate_urdf  # noqa: PLC0415
     from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
-    from thorvald_sim.robot import Pose2D  # noqa: PLC0415
-    from thorvald_sim.simulation import Simulation  # noqa: PLC0415
+    from thorvald_sim.physics.robot import Pose2D  # noqa: PLC0415
+    from thorvald_sim.physics.simulation import Simulation  # noqa: PLC0415
     from thorvald_sim.world import load_world, resolve_world  # noqa: PLC0415
 
     urdf = generate_urdf(STD)

@@ -26,9 +26,9 @@ import time
 
 from thorvald_model.description import generate_urdf
 from thorvald_sim.bullet import pybullet as p
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.scene import build_scene
-from thorvald_sim.simulation import Simulation
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.scene import build_scene
+from thorvald_sim.physics.simulation import Simulation
 from thorvald_sim.world import load_world, resolve_world, shipped_worlds
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))

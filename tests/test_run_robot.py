@@ -16,7 +16,7 @@ import subprocess
 import pytest
 
 from thorvald_model.description import package_file as model_file
-from thorvald_sim.runner import RunOptions, TimedTwist, read_commands, run_robot, write_commands
+from thorvald_sim.tools.runner import RunOptions, TimedTwist, read_commands, run_robot, write_commands
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 

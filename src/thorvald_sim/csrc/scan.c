@@ -5,7 +5,7 @@
  * simulator node another 120 us a scan, most of it the overhead of a dozen small numpy calls on
  * caches the physics step has just flushed (the noise added to the ranges alone: two of them). These
  * two loops do the same in a few microseconds.
- * thorvald_sim.sensors uses numpy where this module is not built, with the same results
+ * thorvald_sim.sensors.kinds.lidar uses numpy where this module is not built, with the same results
  * (test_sensors compares them).
  */
 #define PY_SSIZE_T_CLEAN

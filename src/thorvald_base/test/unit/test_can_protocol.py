@@ -12,7 +12,7 @@ from thorvald_base.can import protocol as pr
 from thorvald_base.can.dbc import main, robot_dbc
 from thorvald_base.errors import MalformedFrame
 from thorvald_model import load_robot_config
-from thorvald_sim.can_emulator import load_dbc
+from thorvald_sim.can.emulator import load_dbc
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.path.abspath(os.path.join(HERE, "..", "..", ".."))

@@ -58,7 +58,7 @@ from thorvald_base.calibration.toe_balance import toe_gauge
 from thorvald_base.calibration.torque_balance import relative_errors
 from thorvald_base.verification import SIDE
 from thorvald_model import ConfigError, load_robot_config, with_drive_param
-from thorvald_sim.as_built import PROFILES, as_built_for
+from thorvald_sim.physics.as_built import PROFILES, as_built_for
 
 from .errors import DriveError, ThorvaldBringupError
 from .odometry_report_cli import drive, robot_file, run_launch

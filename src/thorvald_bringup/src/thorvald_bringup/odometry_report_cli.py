@@ -32,8 +32,8 @@ from thorvald_base.verification import MANOEUVRES, SIDE
 from thorvald_model import ConfigError, examples, load_robot_config
 from thorvald_model.errors import UnknownRobotError
 from thorvald_model.ports import free_port
-from thorvald_sim.as_built import PROFILES, as_built_for, describe_as_built
-from thorvald_sim.params import MAX_WORKERS
+from thorvald_sim.physics.as_built import PROFILES, as_built_for, describe_as_built
+from thorvald_sim.physics.presets import MAX_WORKERS
 
 from .errors import DriveError, ReportError, ThorvaldBringupError, UnknownRobot
 

@@ -1,6 +1,6 @@
 """Where a scenario drives a candidate: a simulation of the candidate's own in a world the scenario
 writes (:class:`Lab`, :class:`LabSession`), on the simulator library's runner
-(:class:`thorvald_sim.runner.RobotSession`): the candidate's own base_driver core on drives measured
+(:class:`thorvald_sim.tools.runner.RobotSession`): the candidate's own base_driver core on drives measured
 from the simulated joints, in lockstep, seeded, without a ROS master. Everything it reads of the
 robot (pose, outline, centre of mass, motor and wheel loads, a picture) the session offers.
 
@@ -11,9 +11,9 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
-from thorvald_sim.robot import MotorLoad
-from thorvald_sim.runner import RobotSession, RunOptions, Sample
-from thorvald_sim.simulation import Camera, save_png
+from thorvald_sim.physics.robot import MotorLoad
+from thorvald_sim.physics.simulation import Camera, save_png
+from thorvald_sim.tools.runner import RobotSession, RunOptions, Sample
 from thorvald_sim.world import parse_world
 
 from .scenarios.kind import Pose, Twist
@@ -93,7 +93,7 @@ class LabSession:
     def _centre_of_mass(self) -> Tuple[float, float, float]:
         """[m] the simulated robot's centre of mass in base_link at the spawn pose: every body's mass
         where pybullet holds it: the description's, since the simulator loads each merged link's mass
-        at its centre (thorvald_sim.description.centre_fixed_links); measured, so that a fault of the
+        at its centre (thorvald_sim.physics.description.centre_fixed_links); measured, so that a fault of the
         loading would show beside the prediction, as pybullet's merge of fixed links did (3.9 cm
         higher on the example three-wheelers)."""
         return self._session.centre_of_mass()

@@ -86,7 +86,7 @@ TOP_KEYS = (
 )
 CANDIDATE_KEYS = (
     Key("robot", str),
-    Key("as_built", str, ""),  # an as-built file or PROFILE:SEED (thorvald_sim.as_built)
+    Key("as_built", str, ""),  # an as-built file or PROFILE:SEED (thorvald_sim.physics.as_built)
 )
 PAYLOAD_KEYS = (
     Key("mass", float, **NON_NEGATIVE),

@@ -1,5 +1,5 @@
 """model.launch's datum_file (a robot_localization datum file) reaches the simulator through the
-description's simulator block (thorvald_model.datum, the xacro's <datum>, thorvald_sim.description)."""
+description's simulator block (thorvald_model.datum, the xacro's <datum>, thorvald_sim.physics.description)."""
 
 import math
 import os

@@ -204,7 +204,7 @@ def test_frames_are_the_links_under_every_namespace(prefix):
     """As the plugins resolve frameName (gazebo_ros: tf::resolve with the tf_prefix parameter or else
     the robot's namespace; imu_sensor and hector: as written), every sensor's frame_id is its link,
     whether or not the tf_prefix parameter is set, and the simulator reads every block."""
-    sensor_blocks = pytest.importorskip("thorvald_sim.sensor_blocks")
+    sensor_blocks = pytest.importorskip("thorvald_sim.sensors.blocks")
     blocks = sensor_blocks.read_sensor_blocks(urdf_text(STD, prefix))
     assert not blocks.refused and not blocks.unsupported
     links = set(by_name(tree(prefix=prefix), "link"))
@@ -331,7 +331,7 @@ def test_every_macro_alone_with_its_defaults(tmp_path):
     assert not [e.tag for e in gnss if e.tag.startswith("reference")]
     assert len(links["gnss_link"].findall("collision")) == 2  # the antenna and its mast
 
-    sensor_blocks = pytest.importorskip("thorvald_sim.sensor_blocks")
+    sensor_blocks = pytest.importorskip("thorvald_sim.sensors.blocks")
     blocks = sensor_blocks.read_sensor_blocks(ET.tostring(root, encoding="unicode"))
     assert not blocks.refused and not blocks.unsupported
     assert sorted(s.kind for s in blocks.sensors) == ["depth", "gps", "imu", "laser", "laser", "laser", "multilayer"]
@@ -410,7 +410,7 @@ class Loaded:
     """The description in a pybullet DIRECT client, fixed base, every link its own (no merging)."""
 
     def __init__(self, p, urdf: str, tmp_path):
-        description = pytest.importorskip("thorvald_sim.description")
+        description = pytest.importorskip("thorvald_sim.physics.description")
         text_, missing = description.resolve_meshes(
             urdf, description.mesh_finder(lambda name: PKG if name == "thorvald_model" else None)
         )

@@ -1,6 +1,6 @@
 """Tables the docs hold that are rendered from a registry (the world file's keys, the sensor kinds):
 written into a markdown file between two marker lines, ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->``,
-by ``python -m thorvald_sim.world --update docs/worlds.md`` and ``python -m thorvald_sim.sensor_kinds
+by ``python -m thorvald_sim.world --update docs/worlds.md`` and ``python -m thorvald_sim.sensors.kinds
 --update docs/sensors.md``; each registry's test checks the docs hold what it renders."""
 
 import argparse

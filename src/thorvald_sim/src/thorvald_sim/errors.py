@@ -4,9 +4,9 @@ a service answers with its text).
 
 Every exception class of the package is here. Those that were a built-in class before they joined
 this module (a ValueError, a RuntimeError) still are, for code that catches that. The first ones are
-also importable from the modules that raise them (``thorvald_sim.simulation``'s SpawnError,
-``thorvald_sim.description``'s DescriptionError, ...), where code written before this module imports
-them; :class:`SensorKindError` from the kinds' registry, :mod:`thorvald_sim.sensor_kinds`, where a
+also importable from the modules that raise them (``thorvald_sim.physics.simulation``'s SpawnError,
+``thorvald_sim.physics.description``'s DescriptionError, ...), where code written before this module imports
+them; :class:`SensorKindError` from the kinds' registry, :mod:`thorvald_sim.sensors.kinds`, where a
 kind from outside is registered.
 """
 
@@ -52,12 +52,12 @@ class ModelError(SpawnError):
 
 
 class WorkerError(ThorvaldSimError, RuntimeError):
-    """A physics worker (:mod:`thorvald_sim.workers`) that could not start, or failed a request other
+    """A physics worker (:mod:`thorvald_sim.physics.workers`) that could not start, or failed a request other
     than a spawn's refusal (its text)."""
 
 
 class SpawnInputError(ThorvaldSimError):
-    """spawn_robot's or spawn_model's model text cannot be sent (:mod:`thorvald_sim.spawn_args`): the
+    """spawn_robot's or spawn_model's model text cannot be sent (:mod:`thorvald_sim.spawn.args`): the
     message says why (file, parameter, XML), in gazebo_ros's words where it has them."""
 
 
@@ -71,14 +71,14 @@ class MeshReadError(ThorvaldSimError, ValueError):
 
 
 class MalformedTf(ThorvaldSimError, ValueError):
-    """Bytes that are not a serialised tf2_msgs/TFMessage (:mod:`thorvald_sim.tf_watch`)."""
+    """Bytes that are not a serialised tf2_msgs/TFMessage (:mod:`thorvald_sim.node.tf_watch`)."""
 
 
 class SensorKindError(ThorvaldSimError, ValueError):
     """A sensor kind that is not whole (a programming error, raised when the kind is made or
-    registered: :mod:`thorvald_sim.sensor_kinds`)."""
+    registered: :mod:`thorvald_sim.sensors.kinds`)."""
 
 
 class NotSimulated(ThorvaldSimError):
-    """A Gazebo sensor block no sensor kind reads: :func:`thorvald_sim.sensor_blocks.read_sensor_blocks`
+    """A Gazebo sensor block no sensor kind reads: :func:`thorvald_sim.sensors.blocks.read_sensor_blocks`
     lists it as unsupported; it never leaves that function."""

@@ -1,4 +1,4 @@
-"""The as-built file and profile (thorvald_sim.as_built): validated like a robot file, the profile
+"""The as-built file and profile (thorvald_sim.physics.as_built): validated like a robot file, the profile
 seeded and within its tolerances, encoder quantisation in whole counts. Pure: no pybullet, no ROS."""
 
 import math
@@ -9,7 +9,7 @@ import pytest
 from thorvald_base.can.protocol import DriveScaling
 from thorvald_model import load_robot_config
 from thorvald_model.errors import ConfigError
-from thorvald_sim.as_built import (
+from thorvald_sim.physics.as_built import (
     SimAsBuilt,
     as_built_for,
     as_configured,
@@ -191,7 +191,7 @@ def test_the_simulator_gets_radii_offsets_and_the_encoders_resolution():
 def test_spawn_robot_reads_the_as_built_robot(tmp_path):
     import argparse  # noqa: PLC0415
 
-    from thorvald_sim.spawn_robot import read_as_built  # noqa: PLC0415
+    from thorvald_sim.spawn.spawn_robot import read_as_built  # noqa: PLC0415
 
     def args(as_built, robot_model=STD_PATH):
         return argparse.Namespace(as_built=as_built, robot_model=robot_model)

@@ -15,9 +15,9 @@ import pytest
 from thorvald_base.can.protocol import DriveScaling
 from thorvald_model import load_robot_config
 from thorvald_model.description import generate_urdf
-from thorvald_sim.as_built import AsBuilt, BuiltDrive, DriveAsBuilt, SimAsBuilt, as_configured, for_simulator
-from thorvald_sim.robot import Pose2D, yaw_of
-from thorvald_sim.simulation import Simulation, SpawnError
+from thorvald_sim.physics.as_built import AsBuilt, BuiltDrive, DriveAsBuilt, SimAsBuilt, as_configured, for_simulator
+from thorvald_sim.physics.robot import Pose2D, yaw_of
+from thorvald_sim.physics.simulation import Simulation, SpawnError
 from thorvald_sim.world import parse_world
 
 HERE = os.path.dirname(os.path.abspath(__file__))

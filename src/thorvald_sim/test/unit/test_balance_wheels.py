@@ -12,8 +12,8 @@ from thorvald_base.verification import BALANCE_AGAIN, BALANCE_SPEED
 from thorvald_model import load_robot_config
 from thorvald_model.description import package_file
 from thorvald_model.motors import output_torque, propulsion_motor
-from thorvald_sim.as_built import as_built_for
-from thorvald_sim.runner import RobotSession, RunOptions
+from thorvald_sim.physics.as_built import as_built_for
+from thorvald_sim.tools.runner import RobotSession, RunOptions
 
 ASYM = package_file("config", "thorvald_ii_6wd6ws_asym", "thorvald_ii_6wd6ws_asym.yaml")
 LEG, SETTLE, PAUSE = 6.0, 2.0, 1.0  # [s]

@@ -1,4 +1,4 @@
-"""The bumper's block (thorvald_sim.sensor_kinds.bumper): a Gazebo contact sensor with gazebo_ros_bumper,
+"""The bumper's block (thorvald_sim.sensors.kinds.bumper): a Gazebo contact sensor with gazebo_ros_bumper,
 its collisions named as Gazebo's URDF conversion names them, and a block naming one that is not
 there refused with the names there are.
 
@@ -16,9 +16,9 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from thorvald_sim.errors import BlockError
-from thorvald_sim.sensor_blocks import read_sensor_blocks, resolve_frame, resolve_topic
-from thorvald_sim.sensor_kinds.block import FRAME_TF_RESOLVE, Element, Found
-from thorvald_sim.sensor_kinds.bumper import BumperConfig, Shape, gazebo_link, read_bumper
+from thorvald_sim.sensors.blocks import read_sensor_blocks, resolve_frame, resolve_topic
+from thorvald_sim.sensors.kinds.block import FRAME_TF_RESOLVE, Element, Found
+from thorvald_sim.sensors.kinds.bumper import BumperConfig, Shape, gazebo_link, read_bumper
 
 INERTIAL = '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
 BOX = '<collision><origin xyz="0.1 0 0"/><geometry><box size="0.1 0.2 0.3"/></geometry></collision>'

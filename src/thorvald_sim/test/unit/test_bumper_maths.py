@@ -1,4 +1,4 @@
-"""The bumper's maths and messages without pybullet (thorvald_sim.sensor_kinds.bumper): contact points
+"""The bumper's maths and messages without pybullet (thorvald_sim.sensors.kinds.bumper): contact points
 to ContactStates as gazebo_ros_bumper fills them, a point on a collision's shape or not, and the
 gazebo_msgs/ContactsState made of a reading.
 
@@ -11,7 +11,7 @@ import math
 import pytest
 
 from gazebo_msgs.msg import ContactsState
-from thorvald_sim.sensor_kinds.bumper import (
+from thorvald_sim.sensors.kinds.bumper import (
     BumperReading,
     ContactPoint,
     Shape,

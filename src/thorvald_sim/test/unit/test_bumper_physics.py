@@ -1,4 +1,4 @@
-"""The bumper in pybullet (thorvald_sim.sensor_kinds.bumper), no ROS master: a robot driven into a wall.
+"""The bumper in pybullet (thorvald_sim.sensors.kinds.bumper), no ROS master: a robot driven into a wall.
 
 The standard robot (thorvald_model's example, the real xacro) gets a bumper: ``bumper_link``, a box
 0.1 x 0.8 x 0.15 m fixed 0.8 m ahead of base_link and 0.55 m up, so its front face is 0.85 m ahead
@@ -22,13 +22,13 @@ import pytest
 from sim_test_helpers import Recorder
 
 from thorvald_model.description import generate_urdf
-from thorvald_sim.description import link_tree
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.sensor_io import SensorIO
-from thorvald_sim.sensor_kinds.block import Element, Found
-from thorvald_sim.sensor_kinds.bumper import GROUND, read_bumper
-from thorvald_sim.sensors import build_sensors
-from thorvald_sim.simulation import Simulation
+from thorvald_sim.node.sensor_io import SensorIO
+from thorvald_sim.physics.description import link_tree
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation
+from thorvald_sim.sensors.kinds.block import Element, Found
+from thorvald_sim.sensors.kinds.bumper import GROUND, read_bumper
+from thorvald_sim.sensors.mounted import build_sensors
 from thorvald_sim.world import parse_world
 
 pytestmark = pytest.mark.slow  # pybullet: simulations of several seconds

@@ -22,7 +22,7 @@ from thorvald_base.kinematics import DriveCommand
 from thorvald_base.params import DriverParams
 from thorvald_base.plugins import load_calculator
 from thorvald_model import load_robot_config, parse_robot_config
-from thorvald_sim.can_emulator import CanEmulator
+from thorvald_sim.can.emulator import CanEmulator
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CONFIGS = os.path.abspath(os.path.join(HERE, "..", "..", "..", "thorvald_model", "config"))

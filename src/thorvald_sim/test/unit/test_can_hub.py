@@ -9,7 +9,7 @@ import can
 import pytest
 
 from thorvald_base.can.slcan import BufferedSlcanBus
-from thorvald_sim.can_hub import Hub, decode_slcan, encode_slcan
+from thorvald_sim.can.hub import Hub, decode_slcan, encode_slcan
 
 
 def test_slcan_lines_both_ways():

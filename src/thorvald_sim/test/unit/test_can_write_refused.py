@@ -26,7 +26,7 @@ from thorvald_base.can.devices import LOST_AFTER
 from thorvald_base.can.outbox import MAX_WAIT
 from thorvald_base.kinematics import DriveCommand
 from thorvald_model import load_robot_config
-from thorvald_sim.can_emulator import CanEmulator
+from thorvald_sim.can.emulator import CanEmulator
 
 SLCAN_OPEN = slcanBus._SLEEP_AFTER_SERIAL_OPEN  # [s] python-can's slcan waits after opening a port
 

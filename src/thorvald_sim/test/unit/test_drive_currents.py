@@ -10,11 +10,11 @@ import pytest
 from thorvald_model import load_robot_config
 from thorvald_model.description import generate_urdf, package_file
 from thorvald_model.motors import Motor, propulsion_motor, steering_motor, winding_current
-from thorvald_sim.as_built import BuiltDrive, SimAsBuilt
-from thorvald_sim.description import DescriptionError, parse_description
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.runner import RobotSession, RunOptions
-from thorvald_sim.simulation import Simulation
+from thorvald_sim.physics.as_built import BuiltDrive, SimAsBuilt
+from thorvald_sim.physics.description import DescriptionError, parse_description
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation
+from thorvald_sim.tools.runner import RobotSession, RunOptions
 from thorvald_sim.world import load_world, resolve_world
 
 ASYM = package_file("config", "thorvald_ii_6wd6ws_asym", "thorvald_ii_6wd6ws_asym.yaml")

@@ -11,11 +11,11 @@ import pytest
 from models_fixtures import box_sdf, gate_sdf
 
 from thorvald_model.description import generate_urdf
-from thorvald_sim.engine import EVERYTHING, Engine, WorldSettings
 from thorvald_sim.gazebo import frames
 from thorvald_sim.gazebo.bodies import MAX_SINK, MODEL_FRAME, STATES_LINKS, STATES_MODELS, Job
 from thorvald_sim.models import parse_sdf_model
-from thorvald_sim.robot import Pose2D
+from thorvald_sim.physics.engine import EVERYTHING, Engine, WorldSettings
+from thorvald_sim.physics.robot import Pose2D
 from thorvald_sim.world import parse_world
 
 pytestmark = pytest.mark.slow  # pybullet: seconds of simulation

@@ -5,11 +5,11 @@ import threading
 
 import pytest
 
-from thorvald_sim.commands import APPLY, HOLD, STREAM_ALIVE, CommandSlot
 from thorvald_sim.errors import ParameterError, ThorvaldSimError
-from thorvald_sim.lockstep import Lockstep
-from thorvald_sim.pacing import FollowerWait, Pacer
-from thorvald_sim.params import SimulatorParams
+from thorvald_sim.node.commands import APPLY, HOLD, STREAM_ALIVE, CommandSlot
+from thorvald_sim.node.lockstep import Lockstep
+from thorvald_sim.node.pacing import FollowerWait, Pacer
+from thorvald_sim.node.params import SimulatorParams
 
 
 class FakeClock:

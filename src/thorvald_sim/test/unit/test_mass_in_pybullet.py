@@ -2,7 +2,7 @@
 mass, and the centre of mass in base_link's frame (every body's mass at its inertial frame, read
 back from pybullet), to a micrometre; reading the description link by link, and as the simulator
 spawns it, its fixed links merged (URDF_MERGE_FIXED_LINKS, which put the merged base's centre of
-mass 1 to 4 cm too high until thorvald_sim.description.centre_fixed_links)."""
+mass 1 to 4 cm too high until thorvald_sim.physics.description.centre_fixed_links)."""
 
 import glob
 import os
@@ -14,8 +14,8 @@ import pytest
 
 from thorvald_model.description import generate_urdf
 from thorvald_model.mass_properties import mass_properties
-from thorvald_sim.description import parse_description
-from thorvald_sim.robot import Pose2D, SimRobot
+from thorvald_sim.physics.description import parse_description
+from thorvald_sim.physics.robot import Pose2D, SimRobot
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 EXAMPLES = sorted(glob.glob(os.path.join(HERE, "..", "..", "..", "thorvald_model", "config", "*", "*.yaml")))

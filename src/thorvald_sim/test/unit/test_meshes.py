@@ -1,5 +1,5 @@
 """Meshes in robot descriptions: found through their packages for pybullet, and those of packages
-that are not installed left out, the link drawn from its other geometry (thorvald_sim.description)."""
+that are not installed left out, the link drawn from its other geometry (thorvald_sim.physics.description)."""
 
 import os
 import xml.etree.ElementTree as ET
@@ -8,9 +8,9 @@ import pybullet as p
 import pytest
 
 from thorvald_model.description import generate_urdf
-from thorvald_sim.description import mesh_finder, resolve_meshes
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.simulation import Simulation, installed_package_path
+from thorvald_sim.physics.description import mesh_finder, resolve_meshes
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation, installed_package_path
 from thorvald_sim.world import parse_world
 
 HERE = os.path.dirname(os.path.abspath(__file__))

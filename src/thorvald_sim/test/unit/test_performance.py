@@ -6,7 +6,7 @@ import time
 import pybullet as p
 import pytest
 
-from thorvald_sim.simulation import Performance, PerformanceMeter, Simulation, performance_report
+from thorvald_sim.physics.simulation import Performance, PerformanceMeter, Simulation, performance_report
 from thorvald_sim.world import parse_world
 
 

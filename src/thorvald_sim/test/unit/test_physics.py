@@ -14,9 +14,9 @@ import yaml
 
 from thorvald_model import load_robot_config
 from thorvald_model.description import generate_urdf
-from thorvald_sim.description import DescriptionError, parse_description
-from thorvald_sim.robot import Pose2D, yaw_of
-from thorvald_sim.simulation import Camera, Simulation, SpawnError
+from thorvald_sim.physics.description import DescriptionError, parse_description
+from thorvald_sim.physics.robot import Pose2D, yaw_of
+from thorvald_sim.physics.simulation import Camera, Simulation, SpawnError
 from thorvald_sim.world import parse_world
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -160,7 +160,7 @@ def test_a_differential_robot_turns_about_the_point_its_wheel_speeds_give(sim):
 
 
 def test_the_wheels_touch_the_ground_with_thin_discs():
-    from thorvald_sim.description import with_tyre_contact  # noqa: PLC0415
+    from thorvald_sim.physics.description import with_tyre_contact  # noqa: PLC0415
 
     xml = urdf(example("thorvald_ii_2wd_diff"))
     thin = with_tyre_contact(xml, ["wheel0", "passive0_wheel"], 0.01)

@@ -12,9 +12,9 @@ import pytest
 
 from thorvald_model import load_robot_config
 from thorvald_model.description import generate_urdf
-from thorvald_sim.description import RAIL_WHEEL_COLLISIONS, narrow_tyres, set_wheel_radii, with_tyre_contact
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.simulation import Simulation
+from thorvald_sim.physics.description import RAIL_WHEEL_COLLISIONS, narrow_tyres, set_wheel_radii, with_tyre_contact
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation
 from thorvald_sim.world import parse_world
 
 HERE = os.path.dirname(os.path.abspath(__file__))

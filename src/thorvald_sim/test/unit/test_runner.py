@@ -1,4 +1,4 @@
-"""thorvald_sim.runner: a robot driven without ROS (its agreement with the ROS path: tests/test_run_robot.py)."""
+"""thorvald_sim.tools.runner: a robot driven without ROS (its agreement with the ROS path: tests/test_run_robot.py)."""
 
 import json
 import math
@@ -11,8 +11,8 @@ import pytest
 
 from thorvald_model.description import package_file
 from thorvald_model.errors import ConfigError
-from thorvald_sim.run_robot import build_parser
-from thorvald_sim.runner import (
+from thorvald_sim.tools.run_robot import build_parser
+from thorvald_sim.tools.runner import (
     RunOptions,
     TimedTwist,
     commands_from_plan,
@@ -114,7 +114,7 @@ def test_the_command_line_writes_its_files_and_refuses_a_broken_commands_file(tm
     cmds = tmp_path / "cmds.csv"
     cmds.write_text("t,vx,vy,wz\n0.5,0.5,0,0\n2.0,0,0,0\n")
     out = tmp_path / "out"
-    argv = [sys.executable, "-m", "thorvald_sim.run_robot", STD, "--commands", str(cmds), "--out", str(out)]
+    argv = [sys.executable, "-m", "thorvald_sim.tools.run_robot", STD, "--commands", str(cmds), "--out", str(out)]
     run = subprocess.run(argv, capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr
     assert {"ground_truth.csv", "odometry.csv", "summary.json"} <= set(os.listdir(out))
@@ -132,7 +132,7 @@ def test_the_command_line_takes_an_example_robots_name_as_the_other_tools_do(tmp
     out = tmp_path / "out"
 
     def run_robot_command(robot, out):
-        argv = [sys.executable, "-m", "thorvald_sim.run_robot", robot, "--commands", str(cmds), "--out", str(out)]
+        argv = [sys.executable, "-m", "thorvald_sim.tools.run_robot", robot, "--commands", str(cmds), "--out", str(out)]
         return subprocess.run([*argv, "--hold", "0.3"], capture_output=True, text=True, timeout=300)
 
     run = run_robot_command("thorvald_ii_2wd_diff", out)
@@ -175,7 +175,7 @@ def test_the_fleet_physics_preset_keeps_the_papers_figures_at_half_the_rate():
 
     from thorvald_base.verification import plan_for  # noqa: PLC0415
     from thorvald_model import load_robot_config  # noqa: PLC0415
-    from thorvald_sim.simulation import Simulation  # noqa: PLC0415
+    from thorvald_sim.physics.simulation import Simulation  # noqa: PLC0415
     from thorvald_sim.world import load_world, resolve_world  # noqa: PLC0415
 
     commands = commands_from_plan(plan_for(load_robot_config(STD))[1], 1.0)

@@ -1,4 +1,4 @@
-"""The RViz configuration of a robot's sensors (thorvald_sim.rviz_sensors): a display per sensor topic,
+"""The RViz configuration of a robot's sensors (thorvald_sim.sensors.rviz): a display per sensor topic,
 at the topic the simulator publishes, on top of thorvald_model's model.rviz."""
 
 import math
@@ -7,8 +7,8 @@ import os
 import yaml
 
 from thorvald_model.description import generate_urdf, package_file
-from thorvald_sim.rviz_sensors import root_link, rviz_config, sensor_displays
-from thorvald_sim.sensor_blocks import read_sensor_blocks
+from thorvald_sim.sensors.blocks import read_sensor_blocks
+from thorvald_sim.sensors.rviz import root_link, rviz_config, sensor_displays
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 STD = os.path.join(

@@ -6,7 +6,7 @@ import math
 import pybullet as p
 import pytest
 
-from thorvald_sim.scene import build_scene
+from thorvald_sim.physics.scene import build_scene
 from thorvald_sim.world import load_world, parse_world, resolve_world, shipped_worlds
 
 TOP = 5.0  # [m]: rays start this high and end 1 m below the ground

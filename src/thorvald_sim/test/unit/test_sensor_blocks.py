@@ -1,4 +1,4 @@
-"""Gazebo sensor blocks read as gazebo_ros's plugins read them (thorvald_sim.sensor_blocks): names,
+"""Gazebo sensor blocks read as gazebo_ros's plugins read them (thorvald_sim.sensors.blocks): names,
 defaults, topics, frames, and a broken block refusing that sensor only."""
 
 import math
@@ -7,8 +7,8 @@ import os
 import pytest
 
 from thorvald_model.description import generate_urdf
-from thorvald_sim.description import parse_description
-from thorvald_sim.sensor_blocks import (
+from thorvald_sim.physics.description import parse_description
+from thorvald_sim.sensors.blocks import (
     HECTOR_REFERENCE,
     Datum,
     gps_reference,

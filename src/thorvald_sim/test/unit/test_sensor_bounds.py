@@ -1,10 +1,10 @@
-"""What one reading may cost, bounded when the blocks are read (thorvald_sim.sensor_blocks): each bound
+"""What one reading may cost, bounded when the blocks are read (thorvald_sim.sensors.blocks): each bound
 holds at its limit and refuses one past it, with the link, the element path, the value and the rule,
 and the robot keeps its other sensors."""
 
 import pytest
 
-from thorvald_sim.sensor_blocks import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_RAYS, read_sensor_blocks
+from thorvald_sim.sensors.blocks import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_RAYS, read_sensor_blocks
 
 IMU = """<gazebo reference="imu_link"><sensor type="imu" name="imu"><update_rate>100</update_rate>
   <plugin name="i" filename="libgazebo_ros_imu_sensor.so"><topicName>imu</topicName>

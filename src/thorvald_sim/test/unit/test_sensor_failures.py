@@ -1,4 +1,4 @@
-"""A sensor the robot goes without (thorvald_sim.sensor_io, thorvald_sim.sensors): a reading that fails
+"""A sensor the robot goes without (thorvald_sim.node.sensor_io, thorvald_sim.sensors.mounted): a reading that fails
 disables that sensor alone, logged once and reported as an error from then on, while the robot's other
 sensors keep measuring; a block past a bound is refused at spawn and reported the same way; and a lidar
 at the bound of rays reads every one of them (pybullet takes 16383 rays a call, and for 16384 it
@@ -19,11 +19,11 @@ import pytest
 from sensor_msgs.msg import LaserScan
 from sim_test_helpers import Recorder
 
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.sensor_blocks import MAX_RAYS
-from thorvald_sim.sensor_io import RobotSensors
-from thorvald_sim.sensors import ERROR, RAY_BATCH, build_sensors, disabled_report, refused_sensors
-from thorvald_sim.simulation import Simulation
+from thorvald_sim.node.sensor_io import RobotSensors
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation
+from thorvald_sim.sensors.blocks import MAX_RAYS
+from thorvald_sim.sensors.mounted import ERROR, RAY_BATCH, build_sensors, disabled_report, refused_sensors
 from thorvald_sim.world import parse_world
 
 INERTIAL = '<inertial><mass value="{m}"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'

@@ -1,9 +1,9 @@
 """Frame ids a sensor publishes, and the links model plugins name, as tf2 reads them: no leading
-slash, no doubled slash (thorvald_sim.sensor_blocks, without pybullet)."""
+slash, no doubled slash (thorvald_sim.sensors.blocks, without pybullet)."""
 
 import pytest
 
-from thorvald_sim.sensor_blocks import read_sensor_blocks, resolve_frame
+from thorvald_sim.sensors.blocks import read_sensor_blocks, resolve_frame
 
 
 def robot(*blocks: str) -> str:

@@ -1,4 +1,4 @@
-"""The simulator's sensor messages (thorvald_sim.sensor_io) that are serialised our way."""
+"""The simulator's sensor messages (thorvald_sim.node.sensor_io) that are serialised our way."""
 
 import io
 import math
@@ -7,7 +7,7 @@ import numpy as np
 import rospy
 from sensor_msgs.msg import Image, LaserScan, PointCloud2
 
-from thorvald_sim.sensor_io import (
+from thorvald_sim.node.sensor_io import (
     CAMERA_DTYPE,
     CAMERA_FIELDS,
     LIDAR_DTYPE,

@@ -1,4 +1,4 @@
-"""Sensor kinds (thorvald_sim.sensor_kinds): one registry entry a kind, holding its block reader, its
+"""Sensor kinds (thorvald_sim.sensors.kinds): one registry entry a kind, holding its block reader, its
 model, its messages and its RViz displays; a new kind is one module and one registry line.
 
 Every registered kind is checked whole, on its own example block: the block reader gives a sensor of
@@ -23,11 +23,11 @@ import pytest
 from sim_test_helpers import Recorder
 
 from thorvald_sim.doc_tables import markers
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.rviz_sensors import sensor_displays
-from thorvald_sim.sensor_blocks import read_sensor_blocks
-from thorvald_sim.sensor_io import SensorIO, message_class
-from thorvald_sim.sensor_kinds import (
+from thorvald_sim.node.sensor_io import SensorIO, message_class
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation
+from thorvald_sim.sensors.blocks import read_sensor_blocks
+from thorvald_sim.sensors.kinds import (
     BUILT_IN,
     KINDS_TABLE,
     SensorKind,
@@ -37,7 +37,7 @@ from thorvald_sim.sensor_kinds import (
     registered,
     sensor_kinds,
 )
-from thorvald_sim.sensor_kinds.block import (
+from thorvald_sim.sensors.kinds.block import (
     FRAME_TF_RESOLVE,
     NON_NEGATIVE,
     Found,
@@ -46,9 +46,9 @@ from thorvald_sim.sensor_kinds.block import (
     read_pose,
     unpack,
 )
-from thorvald_sim.sensor_kinds.lidar import LASER
-from thorvald_sim.sensor_kinds.model import Sensor
-from thorvald_sim.simulation import Simulation
+from thorvald_sim.sensors.kinds.lidar import LASER
+from thorvald_sim.sensors.kinds.model import Sensor
+from thorvald_sim.sensors.rviz import sensor_displays
 from thorvald_sim.world import parse_world
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -173,7 +173,7 @@ def test_docs_sensors_md_holds_the_table_the_registry_renders():
         text = f.read()
     assert text.count(begin) == 1 and text.count(end) == 1, "docs/sensors.md needs the sensor-kinds markers"
     held = text.split(begin + "\n")[1].split(end)[0]
-    assert held == kinds_markdown(), "run: python -m thorvald_sim.sensor_kinds --update docs/sensors.md"
+    assert held == kinds_markdown(), "run: python -m thorvald_sim.sensors.kinds --update docs/sensors.md"
     assert [row.split("`")[1] for row in held.splitlines()[2:]] == [kind.name for kind in BUILT_IN]
 
 

@@ -1,4 +1,4 @@
-"""Sensors in the pybullet world (thorvald_sim.sensors), each checked against figures the geometry gives.
+"""Sensors in the pybullet world (thorvald_sim.sensors.mounted), each checked against figures the geometry gives.
 
 The test robot is a 0.4 m box (base_link on the ground) with a sensor mast: the lidar's and the
 camera's links 1 m above the ground, fixed to base_link through an intermediate link (so pybullet
@@ -11,10 +11,11 @@ import numpy as np
 import pybullet as p
 import pytest
 
-import thorvald_sim.sensor_kinds.lidar as lidar_module
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.sensor_blocks import Datum
-from thorvald_sim.sensors import (
+import thorvald_sim.sensors.kinds.lidar as lidar_module
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation
+from thorvald_sim.sensors.blocks import Datum
+from thorvald_sim.sensors.mounted import (
     OK,
     WARN,
     WGS84_A,
@@ -26,7 +27,6 @@ from thorvald_sim.sensors import (
     ranges_from_hits,
     sensor_report,
 )
-from thorvald_sim.simulation import Simulation
 from thorvald_sim.world import parse_world
 
 INERTIAL = '<inertial><mass value="{m}"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'

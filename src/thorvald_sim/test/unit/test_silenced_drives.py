@@ -19,8 +19,8 @@ from thorvald_base.bases.can_base import CanBase
 from thorvald_base.core import BLIND, BaseDriverCore
 from thorvald_base.plugins import load_calculator
 from thorvald_model import load_robot_config
-from thorvald_sim.can_emulator import CanEmulator
-from thorvald_sim.runner import RobotSession, RunOptions
+from thorvald_sim.can.emulator import CanEmulator
+from thorvald_sim.tools.runner import RobotSession, RunOptions
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CONFIGS = os.path.abspath(os.path.join(HERE, "..", "..", "..", "thorvald_model", "config"))

@@ -1,4 +1,4 @@
-"""An as-built robot's soft tyres (thorvald_sim.as_built ``tyre_deflection``, the field profile's loaded
+"""An as-built robot's soft tyres (thorvald_sim.physics.as_built ``tyre_deflection``, the field profile's loaded
 tyres): a frame of more than three wheels stands on all of them, as it does on pneumatic tyres, where
 rigid tyres of radii a millimetre apart left it on two."""
 
@@ -6,8 +6,8 @@ import pytest
 
 from thorvald_model import ConfigError, load_robot_config
 from thorvald_model.description import package_file
-from thorvald_sim.as_built import SimAsBuilt, as_built_for, draw_as_built, parse_as_built
-from thorvald_sim.runner import RobotSession, RunOptions
+from thorvald_sim.physics.as_built import SimAsBuilt, as_built_for, draw_as_built, parse_as_built
+from thorvald_sim.tools.runner import RobotSession, RunOptions
 
 ASYM = package_file("config", "thorvald_ii_6wd6ws_asym", "thorvald_ii_6wd6ws_asym.yaml")
 

@@ -1,4 +1,4 @@
-"""spawn_model's and spawn_robot's arguments (thorvald_sim.spawn_args, pure: no master): every argument of
+"""spawn_model's and spawn_robot's arguments (thorvald_sim.spawn.args, pure: no master): every argument of
 gazebo_ros's spawn_model and this workspace's, which service each combination goes to, and a clear
 refusal (exit status 2, the argument and the rule) for each wrong one."""
 
@@ -7,9 +7,9 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from thorvald_sim import spawn_args
 from thorvald_sim.errors import SpawnInputError
-from thorvald_sim.spawn_args import (
+from thorvald_sim.spawn import args as spawn_args
+from thorvald_sim.spawn.args import (
     GAZEBO,
     MODEL_DATABASE_TEMPLATE,
     ROBOT,
@@ -248,6 +248,6 @@ def test_the_argument_module_is_pure():
     import subprocess  # noqa: PLC0415
     import sys  # noqa: PLC0415
 
-    code = "import sys, thorvald_sim.spawn_args; print(sorted(m for m in ('rospy', 'pybullet') if m in sys.modules))"
+    code = "import sys, thorvald_sim.spawn.args; print(sorted(m for m in ('rospy', 'pybullet') if m in sys.modules))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"

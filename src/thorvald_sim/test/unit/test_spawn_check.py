@@ -12,9 +12,9 @@ import pytest
 import xacro
 
 from thorvald_model.description import generate_urdf
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.sensor_blocks import resolve_frame
-from thorvald_sim.simulation import Simulation, SpawnError
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation, SpawnError
+from thorvald_sim.sensors.blocks import resolve_frame
 from thorvald_sim.world import parse_world
 
 HERE = os.path.dirname(os.path.abspath(__file__))

@@ -1,5 +1,5 @@
 """A spawn reads its description once: one parse of the XML that the robot, its tyres, its link tree
-and its sensor blocks all read (thorvald_sim.description.SpawnedDescription)."""
+and its sensor blocks all read (thorvald_sim.physics.description.SpawnedDescription)."""
 
 import xml.etree.ElementTree as ET
 
@@ -7,8 +7,8 @@ import pybullet as p
 import pytest
 
 from thorvald_model.description import generate_urdf, package_file
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.simulation import Simulation
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation
 from thorvald_sim.world import load_world, resolve_world
 
 STD = package_file("config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")

@@ -15,8 +15,8 @@ from thorvald_model import load_robot_config
 from thorvald_model.datum import load_datum
 from thorvald_model.errors import ConfigError
 from thorvald_model.schema import MAX_YAML_DEPTH
-from thorvald_sim.as_built import MAX_SEED, as_built_for, draw_as_built, is_profile_spec, load_as_built
-from thorvald_sim.spawn_names import model_name_problem, namespace_problem
+from thorvald_sim.physics.as_built import MAX_SEED, as_built_for, draw_as_built, is_profile_spec, load_as_built
+from thorvald_sim.spawn.names import model_name_problem, namespace_problem
 from thorvald_sim.world import load_world
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -124,7 +124,7 @@ def test_a_file_whose_name_looks_like_a_profile_is_a_file(tmp_path, monkeypatch)
 def test_spawn_robot_refuses_a_malformed_seed_with_a_config_error():
     import argparse  # noqa: PLC0415
 
-    from thorvald_sim.spawn_robot import read_as_built  # noqa: PLC0415
+    from thorvald_sim.spawn.spawn_robot import read_as_built  # noqa: PLC0415
 
     with pytest.raises(ConfigError, match="SEED must be a whole number"):
         read_as_built(argparse.Namespace(as_built="field:--1", robot_model=STD_PATH))
@@ -173,7 +173,7 @@ def test_a_private_namespace_is_refused():
 
 
 def test_spawn_robot_parses_names_with_the_rules(capsys):
-    from thorvald_sim.spawn_robot import parse_args  # noqa: PLC0415
+    from thorvald_sim.spawn.spawn_robot import parse_args  # noqa: PLC0415
 
     args = parse_args(["-param", "robot_description", "-model", "robot_1", "-robot_namespace", "/robot_1"])
     assert (args.model, args.robot_namespace) == ("robot_1", "/robot_1")
@@ -190,7 +190,7 @@ def test_spawn_robot_parses_names_with_the_rules(capsys):
 
 def test_the_simulators_spawn_service_refuses_the_names_before_anything():
     from thorvald_msgs.srv import SpawnRobotRequest  # noqa: PLC0415
-    from thorvald_sim.services import SimulatorServices  # noqa: PLC0415
+    from thorvald_sim.node.services import SimulatorServices  # noqa: PLC0415
 
     class Untouchable:
         """Simulator services that fail the test if the spawn goes past its checks."""

@@ -1,4 +1,4 @@
-"""thorvald_sim.tf_watch: another publisher of a robot's odom -> base_link found in /tf's raw bytes.
+"""thorvald_sim.node.tf_watch: another publisher of a robot's odom -> base_link found in /tf's raw bytes.
 
 The bytes are genpy's serialisation of real tf2_msgs/TFMessage values (the parser shares nothing
 with it), so a wrong offset in the parser shows as wrong frames.
@@ -11,7 +11,7 @@ from geometry_msgs.msg import TransformStamped
 from tf2_msgs.msg import TFMessage
 
 from thorvald_sim.errors import MalformedTf
-from thorvald_sim.tf_watch import TfWatch, transform_frames
+from thorvald_sim.node.tf_watch import TfWatch, transform_frames
 
 
 def tf_bytes(*pairs, x=0.25):

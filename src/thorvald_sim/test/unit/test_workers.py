@@ -1,4 +1,4 @@
-"""Physics workers (thorvald_sim.workers): a robot stepped in a worker process is the robot stepped in
+"""Physics workers (thorvald_sim.physics.workers): a robot stepped in a worker process is the robot stepped in
 the node's own client, to the bit; the pool places, spawns, deletes and resets robots across workers
 and reports a worker that dies while the others go on.
 
@@ -15,12 +15,12 @@ import pytest
 from sim_test_helpers import Recorder
 
 from thorvald_model.description import generate_urdf
-from thorvald_sim.as_built import AsBuilt, DriveAsBuilt, for_simulator
-from thorvald_sim.engine import NOTHING, LocalPhysics, Reads, WorldSettings
-from thorvald_sim.robot import Pose2D
-from thorvald_sim.sensor_io import RobotSensors
-from thorvald_sim.simulation import Simulation, SpawnError
-from thorvald_sim.workers import PROXIMITY_MARGIN, WorkerPool
+from thorvald_sim.node.sensor_io import RobotSensors
+from thorvald_sim.physics.as_built import AsBuilt, DriveAsBuilt, for_simulator
+from thorvald_sim.physics.engine import NOTHING, LocalPhysics, Reads, WorldSettings
+from thorvald_sim.physics.robot import Pose2D
+from thorvald_sim.physics.simulation import Simulation, SpawnError
+from thorvald_sim.physics.workers import PROXIMITY_MARGIN, WorkerPool
 from thorvald_sim.world import parse_world
 
 HERE = os.path.dirname(os.path.abspath(__file__))

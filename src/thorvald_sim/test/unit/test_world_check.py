@@ -9,7 +9,7 @@ import sys
 import pytest
 import yaml
 
-from thorvald_sim.check_world import plant_count
+from thorvald_sim.tools.check_world import plant_count
 from thorvald_sim.world import load_world, resolve_world, shipped_worlds
 
 WORLD = {
@@ -21,9 +21,9 @@ WORLD = {
 
 
 def check_world(*args):
-    """(exit status, stdout, stderr) of ``python -m thorvald_sim.check_world args``."""
+    """(exit status, stdout, stderr) of ``python -m thorvald_sim.tools.check_world args``."""
     run = subprocess.run(
-        [sys.executable, "-m", "thorvald_sim.check_world", *args], capture_output=True, text=True, timeout=120
+        [sys.executable, "-m", "thorvald_sim.tools.check_world", *args], capture_output=True, text=True, timeout=120
     )
     return run.returncode, run.stdout, run.stderr
 
@@ -119,7 +119,7 @@ def test_json_summaries():
 @pytest.mark.slow  # a process per case: the command as a user types it
 def test_the_command_needs_no_pybullet():
     probe = (
-        "import sys; from thorvald_sim.check_world import main; status = main(['vineyard', 'crop_rows']); "
+        "import sys; from thorvald_sim.tools.check_world import main; status = main(['vineyard', 'crop_rows']); "
         "print(status, 'pybullet' in sys.modules)"
     )
     run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)

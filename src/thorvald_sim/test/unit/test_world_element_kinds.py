@@ -25,8 +25,8 @@ from sim_test_helpers import ray_down
 
 import thorvald_sim.world
 from thorvald_model.schema import Key
-from thorvald_sim.check_world import format_elements, summary
-from thorvald_sim.scene import build_scene
+from thorvald_sim.physics.scene import build_scene
+from thorvald_sim.tools.check_world import format_elements, summary
 from thorvald_sim.world import (
     BUILT_IN,
     LIMITS,
@@ -187,7 +187,7 @@ def _world_modules():
     found = [("thorvald_sim.world", thorvald_sim.world.__file__)]
     for info in pkgutil.walk_packages(thorvald_sim.world.__path__, "thorvald_sim.world."):
         found.append((info.name, importlib.util.find_spec(info.name).origin))
-    return [*found, ("thorvald_sim.scene", importlib.util.find_spec("thorvald_sim.scene").origin)]
+    return [*found, ("thorvald_sim.physics.scene", importlib.util.find_spec("thorvald_sim.physics.scene").origin)]
 
 
 def test_a_built_in_kind_is_its_module_and_its_registry_line():

@@ -10,7 +10,7 @@ import pytest
 import sim_test_helpers
 from PIL import Image
 
-from thorvald_sim.scene import build_scene
+from thorvald_sim.physics.scene import build_scene
 from thorvald_sim.world import load_world, parse_world, resolve_world
 from thorvald_sim.world.kinds.height_field import HeightField
 from thorvald_sim.world.kinds.rows import plant_positions

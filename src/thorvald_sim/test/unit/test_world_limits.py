@@ -17,7 +17,7 @@ import yaml
 from PIL import Image
 from sim_test_helpers import world_problems
 
-from thorvald_sim.scene import build_scene
+from thorvald_sim.physics.scene import build_scene
 from thorvald_sim.world import LIMITS, ConfigError, Limits, limits, load_world, loader, parse_world, worlds_dir
 from thorvald_sim.world.kinds.height_field import HEIGHT_FIELD_KEYS
 from thorvald_sim.world.kinds.objects import OBJECT_KEYS

@@ -12,11 +12,10 @@ import pytest
 import yaml
 from sim_test_helpers import world_problems
 
-from thorvald_sim import mesh_check
-from thorvald_sim.mesh_check import mesh_problem
-from thorvald_sim.scene import build_scene
-from thorvald_sim.world import ConfigError, load_world, parse_world, worlds_dir
+from thorvald_sim.physics.scene import build_scene
+from thorvald_sim.world import ConfigError, load_world, mesh_check, parse_world, worlds_dir
 from thorvald_sim.world.kinds import objects as objects_kind
+from thorvald_sim.world.mesh_check import mesh_problem
 
 CRATE = os.path.join(worlds_dir(), "meshes", "crate.obj")
 TRIANGLE = b"v 0 0 0\nv 1 0 0\nv 0 1 0\n"

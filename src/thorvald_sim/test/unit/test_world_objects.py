@@ -9,7 +9,7 @@ import pytest
 import yaml
 from sim_test_helpers import ray_down, world_problems
 
-from thorvald_sim.scene import build_scene
+from thorvald_sim.physics.scene import build_scene
 from thorvald_sim.world import ConfigError, load_world, parse_world, worlds_dir
 from thorvald_sim.world.kinds.objects import WorldObject
 from thorvald_sim.world.surfaces import Surface

@@ -6,7 +6,7 @@ import pybullet as p
 import pytest
 from sim_test_helpers import world_problems
 
-from thorvald_sim.scene import build_scene
+from thorvald_sim.physics.scene import build_scene
 from thorvald_sim.world import load_world, parse_world, resolve_world
 from thorvald_sim.world.kinds.polytunnels import ARCH_SEGMENTS, TABLE_DEPTH
 

@@ -6,7 +6,7 @@ import pybullet as p
 import pytest
 from sim_test_helpers import ray_down, world_problems
 
-from thorvald_sim.scene import build_scene
+from thorvald_sim.physics.scene import build_scene
 from thorvald_sim.world import ConfigError, load_world, parse_world, resolve_world
 from thorvald_sim.world.bodies import MAX_MESH_VERTICES
 from thorvald_sim.world.kinds.rows import Rows, plant_positions

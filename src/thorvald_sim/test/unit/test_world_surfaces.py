@@ -12,9 +12,9 @@ import sim_test_helpers
 from sim_test_helpers import ray_down
 
 from thorvald_model.description import generate_urdf
-from thorvald_sim.robot import Pose2D, yaw_of
-from thorvald_sim.scene import build_scene
-from thorvald_sim.simulation import Simulation
+from thorvald_sim.physics.robot import Pose2D, yaw_of
+from thorvald_sim.physics.scene import build_scene
+from thorvald_sim.physics.simulation import Simulation
 from thorvald_sim.world import ConfigError, load_world, parse_world, resolve_world
 from thorvald_sim.world.geometry import ground_pieces
 from thorvald_sim.world.kinds.patches import PATCH_TOP, SOFT_DEPTH, soft_patches

@@ -310,7 +310,7 @@ class _Since(Sequence):
 
 def _odometry(session) -> List[Tuple[float, float]]:
     """base_driver's odometry (x, y in the odom frame, the spawn pose) at every control cycle of the
-    session, as the runner records it (:attr:`thorvald_sim.runner.RobotSession.odometry`), one for
+    session, as the runner records it (:attr:`thorvald_sim.tools.runner.RobotSession.odometry`), one for
     each of the session's poses (the lab's session records its pose at the same cycles)."""
     return [(o.x, o.y) for o in session.odometry]
 

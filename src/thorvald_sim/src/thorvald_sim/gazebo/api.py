@@ -13,7 +13,7 @@ This module is the ROS side: it resolves names and reference frames over the wor
 (:mod:`thorvald_sim.gazebo.entities`), and asks the world holding a model (the node's physics, or
 the physics worker holding it) through the physics interface's ``ask`` (answered by
 :class:`thorvald_sim.gazebo.bodies.GazeboBodies`). Robots are spawned by the simulator's own path
-(:class:`thorvald_sim.services.SimulatorServices`), so a robot spawned either way has its topics and
+(:class:`thorvald_sim.node.services.SimulatorServices`), so a robot spawned either way has its topics and
 is a model here. What differs from Gazebo is in docs/coming-from-gazebo.md.
 """
 
@@ -69,7 +69,7 @@ from thorvald_base.publishing import NonBlockingPublisher
 from thorvald_base.rate_grid import RateGrid
 
 from ..errors import SpawnError, WorkerError
-from ..robot import Pose2D
+from ..physics.robot import Pose2D
 from . import frames
 from .bodies import MODEL_FRAME, STATES_LINKS, STATES_MODELS, Job
 from .entities import GROUND, GROUND_KIND, MODEL, ROBOT, WORLD, Entities, Entity, Joint, Link, Model

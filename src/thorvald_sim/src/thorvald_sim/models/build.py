@@ -30,7 +30,7 @@ How Gazebo's model maps onto pybullet (3.2.7):
   a static model's meshes collide as their triangles (concave), a moving model's as the convex hull of
   each object in the file (bullet collides nothing else that moves).
 
-pybullet is imported here only, lazily (``thorvald_sim.bullet``), as engine.py does.
+pybullet is imported here only, lazily (``thorvald_sim.bullet``), as physics/engine.py does.
 """
 
 import math

@@ -1,7 +1,7 @@
 """Mesh files pybullet cannot read itself, read here as triangles: COLLADA (.dae) and ASCII STL.
 
 pybullet 3.2.7's ``createCollisionShape(GEOM_MESH, fileName=...)`` reads OBJ and binary STL only
-(checked: a .dae gives "createCollisionShape failed."; :mod:`thorvald_sim.mesh_check` records that it
+(checked: a .dae gives "createCollisionShape failed."; :mod:`thorvald_sim.world.mesh_check` records that it
 reads no ASCII STL). Gazebo reads all four. So a .dae or ASCII .stl is read here into triangles and
 written once per process as an OBJ file (:func:`pybullet_file`), which pybullet then loads like any
 other (its file loader has no vertex limit; ``vertices=`` takes at most 131072).

@@ -16,7 +16,7 @@ import xml.etree.ElementTree as ET
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 from ..errors import MeshReadError, ModelError
-from ..mesh_check import mesh_problem
+from ..world.mesh_check import mesh_problem
 
 # ---- the limits of one model (a spawned model, or one model of a world) ---------------------------
 MAX_XML_CHARS = 16 * 2**20  # characters of one model's text (and of each file it includes)

@@ -96,7 +96,7 @@ GAZEBO_COLOURS = {
 
 def default_finder(base_dir: Optional[str] = None, model: Optional[MeshFinder] = None) -> MeshFinder:
     """A finder of mesh URIs: ``package://`` (through rospack), ``file://`` and absolute paths as
-    :func:`thorvald_sim.description.mesh_finder` finds a robot's meshes; a relative path in base_dir
+    :func:`thorvald_sim.physics.description.mesh_finder` finds a robot's meshes; a relative path in base_dir
     (the model file's folder); ``model://`` through model (Gazebo's model path: the caller's)."""
     packages: List[MeshFinder] = []
 
@@ -107,7 +107,7 @@ def default_finder(base_dir: Optional[str] = None, model: Optional[MeshFinder] =
             return model(uri)
         if "://" in uri or os.path.isabs(uri) or base_dir is None:
             if not packages:
-                from ..description import mesh_finder  # noqa: PLC0415  (thorvald_model: only once a mesh is named)
+                from ..physics.description import mesh_finder  # noqa: PLC0415  (thorvald_model: only once a mesh is named)
 
                 packages.append(mesh_finder(_package_path))
             return packages[0](uri)

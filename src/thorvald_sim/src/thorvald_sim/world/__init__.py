@@ -8,7 +8,7 @@ frictions are pybullet's per-body coefficients, which pybullet multiplies with t
 simulator's wheels have friction 1.0). Every section's entries are numbered from 0 without gaps
 (``object0``, ``object1``, ...). A colour, ``rgba``, is a list of 3 or 4 numbers in [0, 1] (red,
 green, blue and alpha, 1 if left out). ``rosrun thorvald_sim check_world FILE [FILE ...]``
-(:mod:`thorvald_sim.check_world`) checks world files, or shipped worlds by name, as the simulator
+(:mod:`thorvald_sim.tools.check_world`) checks world files, or shipped worlds by name, as the simulator
 loads them, without starting it.
 
 Validation is the robot configuration's (:mod:`thorvald_model.schema`): every problem is collected
@@ -32,7 +32,7 @@ holes), :mod:`~thorvald_sim.world.terrain` (the height field's maths), :mod:`~th
 of ``docs/worlds.md``, ``python -m thorvald_sim.world`` prints it).
 
 Pure: no pybullet, no rospy, no messages. Each kind's scene builder calls pybullet through
-:mod:`thorvald_sim.world.bodies`, which imports it when :func:`thorvald_sim.scene.build_scene` first
+:mod:`thorvald_sim.world.bodies`, which imports it when :func:`thorvald_sim.physics.scene.build_scene` first
 builds something; the plants' positions, the tunnels' geometry and the heights of the ground are
 computed from the values, so tests check them without a physics engine.
 """

@@ -1,5 +1,5 @@
 """The ground (``ground:``): the plane's surface and colour, a key of the world file that is no
-element kind's (the ground is built by :mod:`thorvald_sim.scene`, around what the kinds make of it).
+element kind's (the ground is built by :mod:`thorvald_sim.physics.scene`, around what the kinds make of it).
 
 The ground's own sinkage makes the whole ground plane soft (not a height field: bullet touches a
 wheel at one to four points of its triangles, rolling or not, so the sinkage would wander). A kind

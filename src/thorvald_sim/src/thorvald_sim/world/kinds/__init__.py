@@ -3,7 +3,7 @@ the order the loader makes them and the scene builds them.
 
 Every part of the simulator that does something per kind of element looks the kinds up here: the
 loader (:func:`thorvald_sim.world.parse_world`: the sections it reads, what each makes and takes of
-the budgets), the scene (:func:`thorvald_sim.scene.build_scene`: each element's bodies, the ground's
+the budgets), the scene (:func:`thorvald_sim.physics.scene.build_scene`: each element's bodies, the ground's
 holes), ``check_world`` (the counts and the extent) and the keys' table (:mod:`thorvald_sim.world.keys_table`).
 
 A kind is a module of its own (its value type, keys, maker and rules, budget, footprint and scene

@@ -2,7 +2,7 @@
 file, static or moving, each on the ground under it unless its ``z`` says otherwise.
 
 An object has its shape's dimensions and no other shape's, and its mesh file exists and is a mesh
-pybullet can load (:mod:`thorvald_sim.mesh_check`: no junk, no STL without triangles or ASCII STL,
+pybullet can load (:mod:`thorvald_sim.world.mesh_check`: no junk, no STL without triangles or ASCII STL,
 no OBJ without faces or with faces naming missing vertices); the mesh files over every object are
 held to the world's limit of bytes (each object counts its file: pybullet loads it for each), their
 sizes read from the file system before any is read.
@@ -22,11 +22,11 @@ from typing import Dict, List, Optional, Sequence, Tuple
 from thorvald_model.errors import MISSING, Problem
 from thorvald_model.schema import NON_NEGATIVE, Key, one_of
 
-from ...mesh_check import mesh_problem
 from ..bodies import p, set_surface
 from ..geometry import Point
 from ..kind import Context, ElementKind, Entry
 from ..limits import bodies_each, over
+from ..mesh_check import mesh_problem
 from ..rules import COORDINATE, OPTIONAL_LENGTH, RGBA_KEY, UNIT_RANGE, Rgba, broken, file_path
 from ..surfaces import Surface, frictions, rgba_text, surface
 
@@ -48,7 +48,7 @@ MESH_EXTENSIONS = (".obj", ".stl")
 class WorldObject:
     """One body: a box (``size_x``, ``size_y``, ``size_z``), cylinder (``radius``, ``length`` along
     its own z), sphere (``radius``) or mesh (``file``, an OBJ or binary STL file, checked at load to
-    be a mesh pybullet can load (:mod:`thorvald_sim.mesh_check`), drawn ``scale`` times).
+    be a mesh pybullet can load (:mod:`thorvald_sim.world.mesh_check`), drawn ``scale`` times).
 
     Only the shape's own dimensions are set; the others are 0 (``file`` empty). The file's ``z`` is
     the centre's (a mesh's origin's) height above the ground under it, by default resting upright on

@@ -8,7 +8,7 @@ square of 2 km about the origin, :func:`thorvald_sim.world.geometry.ground_piece
 is no ground), drawn as the plane; so a soft patch lies within 999 m of the origin in x and y, and a
 world with a height field, which has no holes, has none. Its rectangular pieces are as the plane to
 what drives or slides on them; the pieces beside a turned patch are not quite (see
-:mod:`thorvald_sim.scene`). Each takes a body of the world's budget, and with a soft one each is a
+:mod:`thorvald_sim.physics.scene`). Each takes a body of the world's budget, and with a soft one each is a
 hole (:class:`~thorvald_sim.world.limits.Limits`).
 
 In pybullet: a box 0.02 m thick whose top is 1 mm above the ground, so a wheel on the patch rests on
