@@ -63,7 +63,9 @@ class RefusedCommandsTest(unittest.TestCase):
         first_stop = self.commands.wait_for(stopped, timeout=TIMEOUT + WAIT, since=driving)
         self.assertIsNotNone(first_stop, "the wheels were never stopped: " + describe(self.commands.latest()))
         delay = first_stop.header.stamp.to_sec() - last_good
-        self.assertGreaterEqual(delay, TIMEOUT, "the bad command replaced the good one")
+        # a bad command taken would stop (or change) the wheels at once, not near the timeout; one CI run
+        # with three rostests at a time stamped the stop 2 ms short of it, so the bound allows a cycle
+        self.assertGreaterEqual(delay, TIMEOUT - 0.02, "the bad command replaced the good one")
         self.assertLessEqual(delay, TIMEOUT + 0.02 + MARGIN, "the wheels did not stop at the good command's timeout")
         before = [m for m in self.commands.since(driving) if m.header.stamp < first_stop.header.stamp]
         self.assertTrue(before)
