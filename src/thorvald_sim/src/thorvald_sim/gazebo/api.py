@@ -703,31 +703,30 @@ class GazeboApi:
         if states is None:
             return
         models, links = states
+        at_rest = (ORIGIN, ZERO, ZERO)  # the ground's, and its link's
         if self.model_states.get_num_connections():
-            names, poses, twists = [], [], []
-            for model in self.entities:
-                state = (ORIGIN, ZERO, ZERO) if model.kind == GROUND_KIND else models.get(model.name)
-                if state is not None:
-                    names.append(model.name)
-                    poses.append((*state[0][0], *state[0][1]))
-                    twists.append((*state[1], *state[2]))
-            self.model_states.publish(packed_states(ModelStates, names, poses, twists))
+            rows = [
+                (model.name, at_rest if model.kind == GROUND_KIND else models.get(model.name))
+                for model in self.entities
+            ]
+            self.model_states.publish(_packed_rows(ModelStates, [(n, st) for n, st in rows if st is not None]))
         if links and self.link_states.get_num_connections():
-            names, poses, twists = [], [], []
+            rows = []
             for model in self.entities:
-                if model.kind == GROUND_KIND:
-                    names.append(f"{model.name}::link")
-                    poses.append((0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0))
-                    twists.append((0.0,) * 6)
-                    continue
-                for link, state in zip(model.links, links.get(model.name, ())):
-                    names.append(f"{model.name}::{link.name}")
-                    poses.append((*state[0][0], *state[0][1]))
-                    twists.append((*state[1], *state[2]))
-            self.link_states.publish(packed_states(LinkStates, names, poses, twists))
+                read = [at_rest] if model.kind == GROUND_KIND else links.get(model.name, ())
+                rows += [(f"{model.name}::{link.name}", st) for link, st in zip(model.links, read)]
+            self.link_states.publish(_packed_rows(LinkStates, rows))
 
 
 _PACKED = {}
+
+
+def _packed_rows(kind, rows):
+    """packed_states of (name, (pose, linear, angular)) rows."""
+    names = [name for name, _ in rows]
+    poses = [(*pose[0], *pose[1]) for _, (pose, _, _) in rows]
+    twists = [(*linear, *angular) for _, (_, linear, angular) in rows]
+    return packed_states(kind, names, poses, twists)
 
 
 def packed_states(kind, names, poses, twists):

@@ -29,6 +29,7 @@ from typing import Dict, List, Optional, Sequence, Tuple, Union
 
 from ..bullet import pybullet as p
 from ..errors import SpawnError
+from ..physics.robot import point_velocity
 from . import frames
 from .frames import Pose, Vec3
 
@@ -54,11 +55,6 @@ class Job:
 
     def over(self, now: float) -> bool:
         return self.duration >= 0.0 and now > self.start + self.duration
-
-
-def _origin_velocity(v_com, w, com, origin) -> Vec3:
-    """The velocity of a rigid body's point origin from its centre of mass's: v + w x (origin - com)."""
-    return frames.add(v_com, frames.cross(w, frames.sub(origin, com)))
 
 
 class GazeboBodies:
@@ -186,7 +182,7 @@ class GazeboBodies:
         else:
             pose = built.link_pose(next(name for name, k in built.links.items() if k == link))
         com, v, w = self._com(body, index)
-        return pose, _origin_velocity(v, w, com, pose[0]), w
+        return pose, point_velocity(v, w, com, pose[0]), w
 
     # ---- teleports -----------------------------------------------------------------------------
     def teleport(self, model: str, link, pose: Pose, twist: Tuple[Vec3, Vec3], static: bool) -> Optional[str]:

@@ -94,6 +94,17 @@ Vec3 = Tuple[float, float, float]
 Quat = Tuple[float, float, float, float]
 
 
+def point_velocity(v: Vec3, w: Vec3, com: Vec3, point: Vec3) -> Vec3:
+    """The velocity of a rigid body's point from its centre of mass's velocity v and its angular
+    velocity w (one frame's axes): v + w x (point - com)."""
+    r = (point[0] - com[0], point[1] - com[1], point[2] - com[2])
+    return (
+        v[0] + w[1] * r[2] - w[2] * r[1],
+        v[1] + w[2] * r[0] - w[0] * r[2],
+        v[2] + w[0] * r[1] - w[1] * r[0],
+    )
+
+
 class SimRobot:
     def __init__(
         self,
@@ -406,13 +417,7 @@ class SimRobot:
         com, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=c)
         pos, quat = p.multiplyTransforms(com, orn, *self._to_base_link)
         v, w = p.getBaseVelocity(self.body, physicsClientId=c)
-        r = (pos[0] - com[0], pos[1] - com[1], pos[2] - com[2])
-        v_origin = (
-            v[0] + w[1] * r[2] - w[2] * r[1],
-            v[1] + w[2] * r[0] - w[0] * r[2],
-            v[2] + w[0] * r[1] - w[1] * r[0],
-        )
-        return (tuple(pos), tuple(quat)), v_origin, tuple(w)
+        return (tuple(pos), tuple(quat)), point_velocity(v, w, com, pos), tuple(w)
 
     def odom_pose(self) -> Tuple[Vec3, Quat]:
         """base_link in the robot's odom frame, which is the spawn pose on the ground."""
@@ -425,13 +430,7 @@ class SimRobot:
         com, orn = p.getBasePositionAndOrientation(self.body, physicsClientId=c)
         v, w = p.getBaseVelocity(self.body, physicsClientId=c)
         origin, _ = p.multiplyTransforms(com, orn, *self._to_base_link)
-        r = [origin[i] - com[i] for i in range(3)]
-        # the velocity of base_link's origin: v_com + w x r
-        v_origin = (
-            v[0] + w[1] * r[2] - w[2] * r[1],
-            v[1] + w[2] * r[0] - w[0] * r[2],
-            v[2] + w[0] * r[1] - w[1] * r[0],
-        )
+        v_origin = point_velocity(v, w, com, origin)
         inverse = p.invertTransform((0.0, 0.0, 0.0), orn)
         lin, _ = p.multiplyTransforms(*inverse, v_origin, (0.0, 0.0, 0.0, 1.0))
         ang, _ = p.multiplyTransforms(*inverse, w, (0.0, 0.0, 0.0, 1.0))
