@@ -59,6 +59,16 @@ class Plot:
     caption: str
 
 
+def _plan_axes(ax, xs: Tuple[float, float], ys: Tuple[float, float], title: str) -> None:
+    """A plan view's axes: the extent xs by ys, one metre the same both ways, the axes named."""
+    ax.set_xlim(*xs)
+    ax.set_ylim(*ys)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title)
+
+
 def _figure(width: float, height: float) -> Figure:
     fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
@@ -200,12 +210,7 @@ def plot_tracks(title: str, tracks: Tracks, plan: Optional[WorldMap], note: str,
             if drive.outcome != "ok" and drive.label:
                 ax.annotate(drive.label, (drive.x[-1], drive.y[-1]), xytext=(4, -10), textcoords="offset points",
                             fontsize=7, color=colour)  # fmt: skip
-    ax.set_xlim(x0, x1)
-    ax.set_ylim(y0, y1)
-    ax.set_aspect("equal", adjustable="box")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title(title)
+    _plan_axes(ax, (x0, x1), (y0, y1), title)
     if tracks.drives:
         ax.legend(fontsize=7, loc="best", title="outcome", title_fontsize=7)
     lines = []
@@ -274,12 +279,7 @@ def plot_turning(title: str, tracks: Tracks, turns: Sequence[Optional[TurnView]]
     lo_x, hi_x = (min(xs), max(xs)) if xs else (-1.0, 1.0)
     lo_y, hi_y = (min(ys), max(ys)) if ys else (-1.0, 1.0)
     margin = max(0.3, 0.08 * max(hi_x - lo_x, hi_y - lo_y))
-    ax.set_xlim(lo_x - margin, hi_x + margin)
-    ax.set_ylim(lo_y - margin, hi_y + margin)
-    ax.set_aspect("equal", adjustable="box")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title(title)
+    _plan_axes(ax, (lo_x - margin, hi_x + margin), (lo_y - margin, hi_y + margin), title)
     fig.legend(fontsize=6.5, loc="outside lower center", ncol=1)
     _save(fig, path)
     return fig  # for a test to read what it draws
@@ -322,12 +322,7 @@ def plot_headland(title: str, tracks: Tracks, plan: Optional[WorldMap], note: st
     if rings:  # one legend entry for the rings, in no turn's colour
         ax.scatter([], [], s=55, facecolors="none", edgecolors="#333333", linewidths=1.3,
                    label="a plant touched (ringed in its turn's colour)")  # fmt: skip
-    ax.set_xlim(x0, x1)
-    ax.set_ylim(y0, y1)
-    ax.set_aspect("equal", adjustable="box")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title(title)
+    _plan_axes(ax, (x0, x1), (y0, y1), title)
     if tracks.drives:
         fig.legend(fontsize=7, loc="outside lower center", title="turn", title_fontsize=7)
     if note:
