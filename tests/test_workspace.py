@@ -9,10 +9,6 @@ import subprocess
 import pytest
 import rosbag
 
-from thorvald_base.verification import duration, plan_named
-from thorvald_bringup.odometry_report import check_complete
-from thorvald_bringup.report_bag import read_recording
-from thorvald_model import load_robot_config
 from thorvald_testing import free_port
 
 # the main job (the demo fixture) runs in its first test's set-up: about 3 minutes, 6 on a machine
@@ -105,72 +101,6 @@ def test_main_job_records_a_real_bag_of_the_whole_drive_and_writes_figures_8_and
         with open(png, "rb") as f:
             assert f.read(8) == b"\x89PNG\r\n\x1a\n", name
         assert os.path.getsize(png) > 30000 and png in demo, name
-
-
-def test_the_same_seed_in_lockstep_gives_the_same_report_with_both_cores_busy(demo, tmp_path):
-    """Repeatable runs: the main job's field:3 drive along the field route, uncalibrated (on whatever
-    machine load the suite had), and the same drive again here, beside two processes keeping both
-    cores busy and with the physics in two worker processes (the robot on one of them), read the same
-    figures and record the same drive states, ground truth and odometry, to the bit, every message of
-    them. In lockstep the simulator starts paused, verification_drive unpauses it once every node is
-    connected, base_driver follows its stamped commands instant by instant, every sensor's noise is
-    drawn for its instant, and what the run records is published waiting for its reader and recorded
-    by record_drive, which drops nothing; a worker steps a robot as the node's own client does."""
-    first = os.path.join(WS, "build", "field_route")
-    burners = [subprocess.Popen(["python3", "-c", "while True: pass"]) for _ in range(2)]
-    try:
-        proc = run(
-            [
-                "rosrun",
-                "thorvald_bringup",
-                "odometry_report",
-                "--robot",
-                "thorvald_ii_6wd6ws_asym",
-                "--as-built",
-                "field:3",
-                "--manoeuvre",
-                "field",
-                "--out",
-                str(tmp_path),
-                "--json",
-                str(tmp_path / "figures.json"),
-                "--physics-workers",
-                "2",
-            ],
-            timeout=600,
-        )
-    finally:
-        for burner in burners:
-            burner.kill()
-            burner.wait()
-    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
-    with open(os.path.join(first, "figures.json")) as f:
-        before = json.load(f)
-    with open(tmp_path / "figures.json") as f:
-        again = json.load(f)
-    # neither run let a node go on without the other (their launch logs say where): else they may differ
-    assert before["lockstep_breaks"] == [], before["lockstep_breaks"]
-    assert again["lockstep_breaks"] == [], again["lockstep_breaks"]
-    assert again == before
-    # the recordings themselves: whole (no message lost), and the same at every instant both hold (the
-    # drive ends the launch, whose shutdown takes its own time: one recording runs on a little longer)
-    a = read_recording(os.path.join(first, "odometry_report.bag"))
-    b = read_recording(str(tmp_path / "odometry_report.bag"))
-    for recording in (a, b):
-        check_complete(recording)
-    n = min(len(a.states), len(b.states))
-    config = load_robot_config(
-        os.path.join(WS, "src/thorvald_model/config/thorvald_ii_6wd6ws_asym/thorvald_ii_6wd6ws_asym.yaml")
-    )
-    end = 3.0 + duration(plan_named("field", config)[1])  # 3 s of settling, then the route
-    assert a.states[n - 1][0] > end  # past the manoeuvre's end
-    assert a.states[:n] == b.states[:n]  # stamps, steering, speeds
-    for name in ("truth", "odometry"):
-        pa, pb = getattr(a, name), getattr(b, name)
-        n = min(len(pa.t), len(pb.t))
-        assert pa.t[n - 1] > end, name
-        for field in ("t", "x", "y", "yaw", "vx", "vy", "wz"):
-            assert getattr(pa, field)[:n] == getattr(pb, field)[:n], (name, field)
 
 
 def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determines(demo):

@@ -1,0 +1,78 @@
+"""Repeatable runs under load: the same seed in lockstep gives the same drive, to the bit.
+
+This test makes its own load (two processes spinning on the cores) and must not share the machine with
+other tests' simulations: it is marked ``solo``, and tools/run-tests runs it alone after the parallel
+run (a third simulation beside it can starve a node in lockstep past its 2 s of wall time)."""
+
+import json
+import os
+import subprocess
+
+import pytest
+
+from thorvald_base.verification import duration, plan_named
+from thorvald_bringup.odometry_report import check_complete
+from thorvald_bringup.report_bag import read_recording
+from thorvald_model import examples, load_robot_config
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.solo, pytest.mark.timeout(900)]
+
+WS = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
+ROBOT = "thorvald_ii_6wd6ws_asym"
+
+
+def field_route(out, physics_workers):
+    """odometry_report as the main job runs it for field:3 (the field route, uncalibrated)."""
+    cmd = ["rosrun", "thorvald_bringup", "odometry_report", "--robot", ROBOT, "--as-built", "field:3",
+           "--manoeuvre", "field", "--out", str(out), "--json", str(out / "figures.json"),
+           "--physics-workers", str(physics_workers)]  # fmt: skip
+    return subprocess.run(cmd, cwd=WS, capture_output=True, text=True, timeout=600)
+
+
+def test_the_same_seed_in_lockstep_gives_the_same_report_with_both_cores_busy(tmp_path):
+    """The field:3 robot along the field route, uncalibrated: once on a quiet machine with the physics
+    in the node, and again beside two processes keeping both cores busy with the physics in two worker
+    processes (the robot on one of them). Both read the same figures and record the same drive states,
+    ground truth and odometry, to the bit, every message of them. In lockstep the simulator starts
+    paused, verification_drive unpauses it once every node is connected, base_driver follows its
+    stamped commands instant by instant, every sensor's noise is drawn for its instant, and what the run
+    records is published waiting for its reader and recorded by record_drive, which drops nothing; a
+    worker steps a robot as the node's own client does."""
+    quiet, busy = tmp_path / "quiet", tmp_path / "busy"
+    quiet.mkdir()
+    busy.mkdir()
+    proc = field_route(quiet, physics_workers=1)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    burners = [subprocess.Popen(["python3", "-c", "while True: pass"]) for _ in range(2)]
+    try:
+        proc = field_route(busy, physics_workers=2)
+    finally:
+        for burner in burners:
+            burner.kill()
+            burner.wait()
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    with open(quiet / "figures.json") as f:
+        before = json.load(f)
+    with open(busy / "figures.json") as f:
+        again = json.load(f)
+    # neither run let a node go on without the other (their launch logs say where): else they may differ
+    assert before["lockstep_breaks"] == [], before["lockstep_breaks"]
+    assert again["lockstep_breaks"] == [], again["lockstep_breaks"]
+    assert again == before
+    # the recordings themselves: whole (no message lost), and the same at every instant both hold (the
+    # drive ends the launch, whose shutdown takes its own time: one recording runs on a little longer)
+    a = read_recording(str(quiet / "odometry_report.bag"))
+    b = read_recording(str(busy / "odometry_report.bag"))
+    for recording in (a, b):
+        check_complete(recording)
+    n = min(len(a.states), len(b.states))
+    config = load_robot_config(examples.robot_file(ROBOT))
+    end = 3.0 + duration(plan_named("field", config)[1])  # 3 s of settling, then the route
+    assert a.states[n - 1][0] > end  # past the manoeuvre's end
+    assert a.states[:n] == b.states[:n]  # stamps, steering, speeds
+    for name in ("truth", "odometry"):
+        pa, pb = getattr(a, name), getattr(b, name)
+        n = min(len(pa.t), len(pb.t))
+        assert pa.t[n - 1] > end, name
+        for field in ("t", "x", "y", "yaw", "vx", "vy", "wz"):
+            assert getattr(pa, field)[:n] == getattr(pb, field)[:n], (name, field)
