@@ -36,3 +36,12 @@ def pytest_collection_modifyitems(config, items):
         starts_ros = module is not None and any(v is s for v in vars(module).values() for s in _STARTS_ROS)
         if "ros_env" in getattr(item, "fixturenames", ()) or starts_ros:
             item.add_marker(pytest.mark.ros)
+    # the modules marked long(seconds) first, longest first (stable: the rest in their order), so that in
+    # the parallel run (tools/run-tests: --dist loadfile --no-loadscope-reorder) no core waits at the end
+    # on one that started last
+    items.sort(key=lambda item: -_long_seconds(item))
+
+
+def _long_seconds(item) -> float:
+    marker = item.get_closest_marker("long")
+    return float(marker.args[0]) if marker is not None and marker.args else 0.0

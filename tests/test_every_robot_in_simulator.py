@@ -27,7 +27,7 @@ from every_robot_driver import plan_for
 from thorvald_model import load_robot_config
 from thorvald_testing import Launch, processes_naming
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.long(60)]
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CONFIG = os.path.normpath(os.path.join(HERE, "..", "src", "thorvald_model", "config"))

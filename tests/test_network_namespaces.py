@@ -50,7 +50,7 @@ import time
 import netns_helpers as nh
 import pytest
 
-pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.root]
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.root, pytest.mark.long(60)]
 
 MASTER_URI = f"http://{nh.SUBNET}.1:{nh.MASTER_PORT}"
 SUBNET = ipaddress.ip_network(f"{nh.SUBNET}.0/24")

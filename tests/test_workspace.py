@@ -13,7 +13,7 @@ from thorvald_testing import free_port
 
 # the main job (the demo fixture) runs in its first test's set-up: about 3 minutes, 6 on a machine
 # slowed by its neighbours (seen once in CI: past the suite's 300 s per test)
-pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(660)]
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.long(330), pytest.mark.timeout(660)]
 
 WS = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 TOPICS = ("nav_vel", "twist_mux/cmd_vel", "odometry/base_raw", "odometry/gazebo", "base_state")

@@ -20,6 +20,7 @@ SECONDS = 30.0
 
 
 @pytest.mark.slow
+@pytest.mark.long(55)
 def test_thirty_seconds_beside_two_busy_loops_lose_no_device():
     # a process of its own: the soak lowers nothing and starts processes this one must not inherit
     out = subprocess.run(
