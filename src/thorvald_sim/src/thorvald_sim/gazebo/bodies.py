@@ -73,11 +73,18 @@ class GazeboBodies:
         self.shapes = None  # their shapes, shared (thorvald_sim.models.build.ShapeCache), made with the first
         self.wrenches: List[Job] = []
         self.efforts: List[Job] = []
+        # the static models' states as model_states last read them: nothing moves them but the requests
+        # of MOVES and a reset, which forget them
+        self.at_rest: Dict[str, Tuple[Pose, Vec3, Vec3]] = {}
+
+    MOVES = ("teleport", "configure", "spawn_model", "delete_model")
 
     def handle(self, op: str, *args):
         """One request of the node (Engine.handle's ``("gazebo", op, *args)``), by method name."""
         if op not in self.ASKED:
             raise ValueError(f"unknown Gazebo request {op!r}")
+        if op in self.MOVES:
+            self.at_rest.clear()
         return getattr(self, op)(*args)
 
     # ---- the models' entities ----------------------------------------------------------------
@@ -348,7 +355,14 @@ class GazeboBodies:
         linear, angular) of each link, in :meth:`describe`'s order]})."""
         models, per_link = {}, {}
         for name in list(self.sim.robots) + list(self.models):
-            models[name] = self.state(name)
+            built = self.models.get(name)
+            if built is not None and built.static:  # where it was (10,000 plants cost one read each, once)
+                state = self.at_rest.get(name)
+                if state is None:
+                    state = self.at_rest[name] = self.state(name)
+                models[name] = state
+            else:
+                models[name] = self.state(name)
             if which & STATES_LINKS:
                 built = self.models.get(name)
                 if built is not None:
@@ -367,6 +381,7 @@ class GazeboBodies:
     def reset(self) -> None:
         """Every model of the API back where it was spawned, at rest, its joints at zero (the robots
         reset themselves)."""
+        self.at_rest.clear()
         c = self.client
         for name, model in self.models.items():
             pose = self.spawned[name]
