@@ -181,6 +181,27 @@ def test_a_reset_puts_the_models_back_where_they_were_spawned(engine):
     assert robot[:2] == pytest.approx((-3.0, 0.0), abs=0.01)
 
 
+def test_the_topics_follow_a_static_model_that_a_request_moves(engine):
+    """A static model's state is read once for the topics and kept: a teleport, a reset and a model
+    deleted and spawned again under its name are seen at the next read."""
+    spawn_model(engine, "post", box_sdf("post", static=True), (1.0, 2.0, 0.1))
+    run(engine, 0.1)
+
+    def where():
+        models, _ = engine.gazebo.states(STATES_MODELS)
+        return models["post"][0][0]
+
+    assert where() == pytest.approx((1.0, 2.0, 0.1), abs=1e-9)
+    assert where() == pytest.approx((1.0, 2.0, 0.1), abs=1e-9)
+    ask(engine, "teleport", "post", MODEL_FRAME, ((4.0, -1.0, 0.1), frames.IDENTITY), ((0, 0, 0),) * 2, True)
+    assert where() == pytest.approx((4.0, -1.0, 0.1), abs=1e-9)
+    assert engine.handle(("reset",)) == ("reset",)
+    assert where() == pytest.approx((1.0, 2.0, 0.1), abs=1e-9)
+    ask(engine, "delete_model", "post")
+    spawn_model(engine, "post", box_sdf("post", static=True), (-2.0, 0.0, 0.1))
+    assert where() == pytest.approx((-2.0, 0.0, 0.1), abs=1e-9)
+
+
 def test_time_set_back_to_zero_ends_every_wrench(engine):
     spawn_model(engine, "box", box_sdf(), (0.0, 0.0, 0.1))
     ask(engine, "add_wrench", Job("box", -1, (10.0, 0.0, 0.0), (0, 0, 0), 5.0, 1.0))
