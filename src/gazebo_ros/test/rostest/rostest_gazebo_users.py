@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """A users' Gazebo launch file (gazebo_users.test) on this workspace: empty_world.launch started
 paused, the robot spawned with ``gazebo_ros spawn_model -urdf -param robot_description ... -unpause``,
-a plain SDF box with ``-sdf -file`` and a URDF turntable with ``-J turn 0.7 -b``.
+a plain SDF box with ``-sdf -file``, a URDF turntable with ``-J turn 0.7 -b`` and a users' model from
+GAZEBO_MODEL_PATH with ``-database``.
 
 - the robot is where spawn_model put it (/gazebo/get_model_state), with its odometry, and drives
   on a navigation stack's velocity command (twist_mux's nav_vel): odometry and Gazebo's model
@@ -71,7 +72,7 @@ class GazeboUsersTest(unittest.TestCase):
         cls.joint = rospy.ServiceProxy("/gazebo/get_joint_properties", GetJointProperties)
         cls.odometry = Latest(f"/{ROBOT}/odometry/base_raw", Odometry)
         cls.nav = rospy.Publisher(f"/{ROBOT}/nav_vel", Twist, queue_size=1)
-        wait_until(lambda: {ROBOT, "box", "turntable"} <= set(cls.world().model_names), "the three spawned models")
+        wait_until(lambda: {ROBOT, "box", "turntable", "post"} <= set(cls.world().model_names), "the spawned models")
         cls.odometry.wait(STARTUP)  # the robot's spawn unpaused the world: time goes on
         wait_until(lambda: cls.nav.get_num_connections() > 0, "twist_mux subscribing to nav_vel")
 
@@ -112,6 +113,20 @@ class GazeboUsersTest(unittest.TestCase):
         self.assertAlmostEqual(pose.x, 3.0, delta=0.02)
         self.assertAlmostEqual(pose.y, 2.0, delta=0.02)
         self.assertAlmostEqual(pose.z, 0.2, delta=0.02)  # 0.4 m a side, on the ground
+
+    def test_3b_a_model_from_gazebos_model_path_stands_where_it_was_put_and_collides_as_its_mesh(self):
+        """-database marker_post: the model's folder on GAZEBO_MODEL_PATH, its model.config's newer SDF,
+        its collision an OBJ found through model://: a box dropped on the 1 m post rests on its top."""
+        pose = self.state("post", "world").pose
+        self.assertAlmostEqual(pose.position.x, 2.0, delta=1e-6)
+        self.assertAlmostEqual(pose.position.y, -3.0, delta=1e-6)
+        self.assertAlmostEqual(yaw_of(pose.orientation), 0.5, delta=1e-6)
+        with open(os.path.join(DATA, "box.sdf"), encoding="utf-8") as f:
+            box = f.read()
+        on_top = Pose(Point(2.0, -3.0, 1.5), Quaternion(0, 0, math.sin(0.25), math.cos(0.25)))
+        self.assertTrue(gazebo_interface.spawn_sdf_model_client("cap", box, "", on_top, "", "/gazebo"))
+        sim_sleep(1.5)
+        self.assertAlmostEqual(self.state("cap", "world").pose.position.z, 1.2, delta=0.02)  # 1 m + half of 0.4 m
 
     def test_4_the_turntable_joint_is_at_its_initial_position(self):
         response = self.joint("turn")

@@ -19,8 +19,10 @@ is a model here. What differs from Gazebo is in docs/coming-from-gazebo.md.
 
 import io
 import math
+import os
 import struct
 import threading
+import xml.etree.ElementTree as ET
 from dataclasses import replace
 from typing import Dict, Optional, Tuple
 
@@ -116,7 +118,6 @@ def _finite(*vectors) -> bool:
 def model_format(xml: str) -> Optional[str]:
     """ "urdf" (a <robot>), "sdf" (an <sdf> or <gazebo>: Gazebo's test), or None, by the root element
     as gazebo_ros tells them apart (its first element, declarations and comments aside)."""
-    import xml.etree.ElementTree as ET  # noqa: PLC0415
 
     try:
         for _, element in ET.iterparse(io.StringIO(xml), events=("start",)):
@@ -126,12 +127,29 @@ def model_format(xml: str) -> Optional[str]:
     return None
 
 
+def _database_uri(xml: str) -> Optional[str]:
+    """The URI gazebo_ros's ``spawn_model -database NAME`` sends (``<sdf><world><include><uri>``, the
+    world holding no model of its own: Gazebo loads the included model), else None."""
+    if "<world" not in xml[:4096]:
+        return None
+    try:
+        root = ET.fromstring(xml)
+    except ET.ParseError:
+        return None
+    world = root.find("world") if root.tag == "sdf" else None
+    if world is None or world.find("model") is not None:
+        return None
+    uri = world.findtext("include/uri")
+    return uri.strip() if uri and uri.strip() else None
+
+
 class GazeboApi:
     """The /gazebo services and topics of a simulator node (its lock, physics, robots and pause)."""
 
     def __init__(self, node, namespace: str = "/gazebo", states_rate: float = 50.0):
         self.node = node
         self.grid = RateGrid(states_rate, node.sim.dt)  # model_states and link_states (0: every step)
+        self._paths = None  # Gazebo's model path (model_path), read when the first model comes
         self.entities = Entities()
         self.entities.add(Model(GROUND, GROUND_KIND, (Link("link", -1, ("collision",)),), static=True, workers=()))
         self.get_state_counts = {}  # get_model_state's header.seq, per model, as Gazebo counts
@@ -217,10 +235,23 @@ class GazeboApi:
         """A model of the API (not a Thorvald robot) into the world (the caller holds the node's lock):
         read once here, built in every world when static, else in the world its place falls to
         (its strip's physics worker). SpawnError when refused; what was done."""
-        from ..models import default_finder, parse_sdf_model, parse_urdf_model  # noqa: PLC0415
+        from ..models import parse_sdf_model, parse_urdf_model  # noqa: PLC0415
 
-        read = parse_sdf_model if kind == "sdf" else parse_urdf_model
-        spec = read(xml, name, default_finder())  # ModelError (a SpawnError) for whatever it refuses
+        paths = self.model_path()
+        source, base_dir = name, None
+        uri = _database_uri(xml) if kind == "sdf" else None
+        if uri is not None:  # gazebo_ros's -database: the model's own SDF from Gazebo's model path
+            found, why = paths.model_sdf(uri)
+            if found is None:
+                raise SpawnError(f"{name}: {why}")
+            xml, source = found
+            base_dir = os.path.dirname(source)
+        find = paths.finder(base_dir)  # model://, package://, file:// as Gazebo finds them
+        # ModelError (a SpawnError) for whatever they refuse
+        if kind == "sdf":
+            spec = parse_sdf_model(xml, source, find, paths.model_sdf)
+        else:
+            spec = parse_urdf_model(xml, source, find)
         spec = replace(spec, name=name)
         for note in spec.notes:
             if (name, note) not in self.said:
@@ -250,6 +281,15 @@ class GazeboApi:
             f"spawned model {name} ({'static' if spec.static else 'dynamic'}, {len(links)} links, "
             f"{len(joints)} moving joints) at ({model_pose[0][0]:g}, {model_pose[0][1]:g}, {model_pose[0][2]:g}){where}"
         )
+
+    def model_path(self):
+        """Gazebo's model path as this process's environment and the ROS packages' exports give it
+        (:class:`~thorvald_sim.models.gazebo_paths.GazeboPaths`), read at the first spawn."""
+        if self._paths is None:
+            from ..models.gazebo_paths import GazeboPaths  # noqa: PLC0415  (rospkg: only when a model comes)
+
+            self._paths = GazeboPaths()
+        return self._paths
 
     def remove_model(self, model: Model) -> None:
         """A model of the API out of every world holding it (the caller holds the node's lock)."""
