@@ -461,9 +461,9 @@ def test_a_heightmap_collision_is_the_height_field(tmp_path):
     hf = world.height_field
     # the brightest pixel at size z above pos z, black at pos z; centred on the origin whatever the
     # model's pose (ODE's field is not moved), the image itself
-    assert (hf.x, hf.y, hf.size_x, hf.size_y) == (0.0, 0.0, 10.0, 12.0)
-    assert (hf.min_height, hf.max_height) == (0.5, 2.5)
-    assert hf.image == str(tmp_path / "terrain.png")
+    assert (hf["x"], hf["y"], hf["size_x"], hf["size_y"]) == (0.0, 0.0, 10.0, 12.0)
+    assert (hf["min_height"], hf["max_height"]) == (0.5, 2.5)
+    assert hf["image"] == str(tmp_path / "terrain.png")
     assert world.models == ()  # the model held the heightmap only
     assert any("model 'terrain': holds the heightmap only" in n for n in world.notes)
     assert any("does not move a heightmap" in n for n in world.notes)
@@ -491,10 +491,10 @@ def test_an_included_terrain_model_is_the_height_field_and_its_image_found_in_it
 
     path = world_file(tmp_path, "<include><uri>model://terrain</uri><pose>5 0 0 0 0 0</pose></include>", name="b.world")
     world = read_gazebo_world(path, gazebo(models))
-    assert world.height_field.image == os.path.join(terrain, "h.png")
+    assert world.height_field["image"] == os.path.join(terrain, "h.png")
     # the brightest pixel (51) at size z, 4 m over the black ones, whatever its level: so white at 4 / (51 / 255)
     hf = world.height_field
-    assert hf.min_height == 0.0 and abs(hf.max_height - 4.0 / (51 / 255)) < 1e-5
+    assert hf["min_height"] == 0.0 and abs(hf["max_height"] - 4.0 / (51 / 255)) < 1e-5
     (model,) = world.models  # the rest of the model stays, where the include puts it
     assert model.pose[0] == (5.0, 0.0, 0.0) and [c.name for c in model.spec.links[0].collisions] == ["post"]
 

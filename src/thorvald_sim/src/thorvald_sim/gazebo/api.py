@@ -69,9 +69,11 @@ from gazebo_msgs.srv import (
 )
 from thorvald_base.publishing import NonBlockingPublisher
 from thorvald_base.rate_grid import RateGrid
+from thorvald_model.errors import ConfigError, Problem
 
 from ..errors import SpawnError, WorkerError
 from ..physics.robot import Pose2D
+from ..world.rules import WHAT
 from . import frames
 from .bodies import MODEL_FRAME, STATES_LINKS, STATES_MODELS, Job
 from .entities import GROUND, GROUND_KIND, MODEL, ROBOT, WORLD, Entities, Entity, Joint, Link, Model
@@ -252,12 +254,17 @@ class GazeboApi:
             spec = parse_sdf_model(xml, source, find, paths.model_sdf)
         else:
             spec = parse_urdf_model(xml, source, find)
+        return self.add_spec(name, spec, frames.in_parent(spec.pose, pose))  # the file's own pose, from the spawn pose
+
+    def add_spec(self, name: str, spec, model_pose) -> str:
+        """A model read (a ModelSpec) into the world at model_pose (its model frame in the world; the
+        caller holds the node's lock): built in every world when static, else in the world its place
+        falls to. SpawnError when refused; what was done."""
         spec = replace(spec, name=name)
         for note in spec.notes:
             if (name, note) not in self.said:
                 self.said.add((name, note))
                 rospy.logwarn("simulator: %s: %s", name, note)
-        model_pose = frames.in_parent(spec.pose, pose)  # the file's own pose, from the spawn pose
         physics = self.node.sim
         if spec.static:
             workers = physics.live_workers()
@@ -281,6 +288,19 @@ class GazeboApi:
             f"spawned model {name} ({'static' if spec.static else 'dynamic'}, {len(links)} links, "
             f"{len(joints)} moving joints) at ({model_pose[0][0]:g}, {model_pose[0][1]:g}, {model_pose[0][2]:g}){where}"
         )
+
+    def add_world_models(self, world) -> None:
+        """The models of a Gazebo world file (WorldConfig.models), each built as :meth:`add_spec` builds a
+        spawned one, so that the API lists and moves them as Gazebo does; what was left out of the file
+        said once each. ConfigError naming the world file and the model a world cannot take."""
+        for note in world.notes:
+            rospy.logwarn("simulator: %s: %s", os.path.basename(world.source), note)
+        for model in world.models:
+            try:
+                self.add_spec(model.name, replace(model.spec, static=model.static), model.pose)
+            except SpawnError as e:
+                problem = Problem(f"model '{model.name}'", model.spec.source, f"is built here: {e}")
+                raise ConfigError(world.source, [problem], WHAT) from None
 
     def model_path(self):
         """Gazebo's model path as this process's environment and the ROS packages' exports give it

@@ -63,7 +63,7 @@ class SimulatorNode:
         self.max_lag = params.max_lag
         self.default_tf = params.publish_tf
         self.paused = params.paused
-        datum = load_datum(params.datum_file) if params.datum_file else None
+        datum = load_datum(params.datum_file) if params.datum_file else world.datum  # a Gazebo world's own
         self.lockstep = params.lockstep
         self.waits = Lockstep()  # lockstep: which robots the world waits for, for which instant
         self.pacer = Pacer(params.real_time_factor)
@@ -94,6 +94,7 @@ class SimulatorNode:
         self.meter = PerformanceMeter(1.0 / params.diagnostics_rate) if params.diagnostics_rate else None
         with self.lock:  # a request that comes as soon as a service is offered waits for both
             self.gazebo = GazeboApi(self, params.gazebo_namespace, params.gazebo_states_rate)  # Gazebo's API
+            self.gazebo.add_world_models(world)  # a Gazebo world file's models, as Gazebo loads them
             self.services = SimulatorServices(self)
         self.publish_clock()
         rospy.loginfo(

@@ -33,6 +33,7 @@ Not pure: it runs pybullet (a DIRECT client of its own, closed at the end). No R
 """
 
 import csv
+import dataclasses
 import json
 import math
 import os
@@ -60,6 +61,7 @@ from ..physics.engine import Engine, WorldSettings
 from ..physics.presets import physics_settings
 from ..physics.robot import Pose2D, Vec3
 from ..world import WorldConfig, load_world, resolve_world
+from ..world.rules import WHAT as WORLD_WHAT
 
 WHAT = "list of commands"
 ONCE = ("directions",)  # a lidar's beams in its frame: the same every reading
@@ -278,6 +280,12 @@ class RobotSession:
         self.client = self.engine.client
         self.sim = self.engine.sim
         try:
+            for model in self.world.models:  # a Gazebo world file's, built as the simulator node builds them
+                spec = dataclasses.replace(model.spec, name=model.name, static=model.static)
+                built = self.engine.gazebo.spawn_model(model.name, spec, model.pose)
+                if isinstance(built, str):
+                    problem = Problem(f"model '{model.name}'", model.spec.source, f"is built here: {built}")
+                    raise ConfigError(self.world.source, [problem], WORLD_WHAT)
             pose = Pose2D(options.x, options.y, options.z, options.yaw, options.roll, options.pitch)
             self.robot = self.sim.spawn(options.robot_name, urdf, pose, as_built)
             calculator = load_calculator(config, estimator=driver.estimator, projection=driver.projection)

@@ -28,6 +28,12 @@ class WorldConfig:
     sections: Tuple[Tuple[str, Any], ...] = ()
     # (section, its kind's ground function) of the kinds that shape the ground (ElementKind.ground)
     shapers: Tuple[Tuple[str, Callable[[Any, float, float], Optional[float]]], ...] = field(default=(), repr=False)
+    # a Gazebo world file's (thorvald_sim.world.gazebo_world): its models (WorldModel: built as models of
+    # the Gazebo API, as Gazebo loads them), its actors, its GNSS datum, and what was read and left out
+    models: Tuple[Any, ...] = ()
+    actors: Tuple[Any, ...] = ()
+    datum: Any = None
+    notes: Tuple[str, ...] = ()
 
     def __getattr__(self, name: str) -> Any:
         # called for a name that is no field or method only: a kind's section; read from __dict__, as

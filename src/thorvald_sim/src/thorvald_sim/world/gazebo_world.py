@@ -126,8 +126,8 @@ from ..models import reading
 from ..models.gazebo_paths import GazeboPaths, included_kind
 from ..models.sdf import LATEST, parse_sdf_model
 from ..models.spec import IDENTITY, Cylinder, Mesh, ModelSpec, Pose, Vec3, compose, pose_from_xyz_rpy, tree
-from .kinds.height_field import HeightField, check_image_budget
 from .limits import LIMITS, Limits
+from .terrain import check_image_budget, image_size
 
 WHAT = "Gazebo world"
 OLDEST = (1, 4)  # the oldest SDF version read here (LATEST, 1.7, the newest)
@@ -304,7 +304,7 @@ class GazeboWorld:
     spherical_coordinates: Optional[SphericalCoordinates] = None  # None: the file has none
     models: Tuple[WorldModel, ...] = ()  # in file order (a population's where it is)
     actors: Tuple[Actor, ...] = ()
-    height_field: Optional[HeightField] = None
+    height_field: Optional[Dict[str, Any]] = None  # our world file's height_field keys (loader.parse_world makes it)
     notes: Tuple[str, ...] = ()  # what was read and left out, each with its element path, one a kind
 
     @property
@@ -385,7 +385,7 @@ class _Reader:
         self.model_elements: List[Tuple[ET.Element, ModelSpec, int]] = []  # (element, spec, instances)
         self.names: Dict[str, ET.Element] = {}
         self.actors: List[Actor] = []
-        self.height_field: Optional[HeightField] = None
+        self.height_field: Optional[Dict[str, Any]] = None
         self.height_field_element: Optional[ET.Element] = None
         self.over_budget = False
 
@@ -998,7 +998,6 @@ class _Reader:
 
     def heightmap(self, collision: ET.Element, base_dir: str, placed: Optional[Pose]) -> None:
         from .gazebo_heightmap import as_height_field  # noqa: PLC0415  (numpy and PIL, for a heightmap only)
-        from .terrain import image_size  # noqa: PLC0415
 
         shape = collision.find("geometry/heightmap")
         if self.height_field is not None:
@@ -1028,7 +1027,8 @@ class _Reader:
         except ValueError as e:
             self.problem(shape, f"{uri} ({found}) {e}", uri)
             return
-        self.height_field = HeightField(**keys.keywords)
+        # our world file's keys: an image gives the grid, so no resolution key
+        self.height_field = {k: v for k, v in keys.keywords.items() if k != "resolution"}
         self.height_field_element = shape
         for difference in keys.differences:
             self.note(shape, f"our height field differs from Gazebo's: {difference}")

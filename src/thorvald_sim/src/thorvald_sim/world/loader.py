@@ -5,6 +5,7 @@ Every problem is collected with its dotted key path, value and rule, and raised 
 :class:`~thorvald_model.errors.ConfigError`; nothing is made that a broken budget counts.
 """
 
+import dataclasses
 import glob
 import os
 from typing import Any, Dict, List, Mapping, Optional, Sequence
@@ -39,13 +40,62 @@ DESCRIPTION_KEY = Key("description", str, "")
 
 
 def load_world(path: str, limits: Limits = LIMITS) -> WorldConfig:
-    """Loads and validates a world file; raises ConfigError naming every problem.
+    """Loads and validates a world file, ours (YAML) or Gazebo's (SDF, told by its content:
+    :func:`~thorvald_sim.world.gazebo_world.is_gazebo_world`); raises ConfigError naming every problem.
 
     A file that cannot be read at all (missing, a directory, not text, not YAML) raises a
     ConfigError with one problem at the top level, which formats as one line. Relative paths in
     the file (meshes, images) are from the file's folder. limits: the budgets it is held to.
     """
+    from .gazebo_world import is_gazebo_world, read_gazebo_world  # noqa: PLC0415  (SDF worlds: when one comes)
+
+    if is_gazebo_world(path):
+        return gazebo_world_config(read_gazebo_world(path, limits=limits), limits)
     return parse_world(read_yaml_file(path, WHAT), path, os.path.dirname(os.path.abspath(path)), limits)
+
+
+def gazebo_world_config(world, limits: Limits = LIMITS) -> WorldConfig:
+    """Our world of a Gazebo world read (:class:`~thorvald_sim.world.gazebo_world.GazeboWorld`): its
+    gravity, its heightmap as the height field, its ground plane as our ground (a static model of
+    planes facing up at z = 0: ``ground_plane``, which the Gazebo API lists as ever; our ground's
+    surface, since ODE's mu is not bullet's friction), every other model and actor as it was read."""
+    gx, gy, gz = world.gravity
+    if abs(gx) > 1e-9 or abs(gy) > 1e-9 or not gz < 0:
+        raise ConfigError(
+            world.source,
+            [Problem("gravity", f"{gx:g} {gy:g} {gz:g}", "points straight down here (x and y 0, z below 0)")],
+            WHAT,
+        )
+    described = f"Gazebo world {world.name!r} ({os.path.basename(world.source)})"
+    folder = os.path.dirname(world.source)
+    data = {"gravity": -gz, "description": described}
+    if world.height_field is not None:  # its heightmap as our height field's keys: made and checked as ours
+        data["height_field"] = world.height_field
+    config = parse_world(data, world.source, folder, limits)
+    models, notes = [], list(world.notes)
+    for model in world.models:
+        if _is_ground_plane(model):
+            notes.append(f"model {model.name!r}: a plane facing up at z = 0, taken as the ground (our ground's)")
+        else:
+            models.append(model)
+    return dataclasses.replace(config, models=tuple(models), actors=world.actors, datum=world.datum, notes=tuple(notes))
+
+
+def _is_ground_plane(model) -> bool:
+    from ..models.spec import Plane  # noqa: PLC0415
+
+    def level(pose) -> bool:  # at z = 0, not tilted
+        return abs(pose[0][2]) < 1e-9 and abs(pose[1][0]) < 1e-9 and abs(pose[1][1]) < 1e-9
+
+    collisions = [c for link in model.spec.links for c in link.collisions]
+    return (
+        model.static
+        and bool(collisions)
+        and level(model.pose)
+        and all(level(link.pose) for link in model.spec.links)
+        and all(isinstance(c.geometry, Plane) and tuple(c.geometry.normal) == (0.0, 0.0, 1.0) for c in collisions)
+        and all(level(c.pose) for c in collisions)
+    )
 
 
 def parse_world(

@@ -1,14 +1,18 @@
 """Terrain: a height field's grid of heights from a grey-scale image, random bumps and ruts, flat
 around the origin (:func:`field_heights`), and what its image and noise cost, counted before they
-are made.
+are made (:func:`check_image_budget`: an image's file and pixels, from its header, which our height
+fields and Gazebo worlds' heightmaps are held to).
 
 numpy and PIL are imported when a field is made, so that importing the world stays cheap. No pybullet.
 """
 
 import math
+import os
 import random
 import warnings
 from typing import Tuple
+
+from .limits import Limits
 
 FLAT_BLEND = 1.0  # [m] over which a height field rises from its flat disc to full height
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -119,3 +123,13 @@ def noise_lattice(size: float, feature_length: float) -> float:
     """Lattice points along one side of a field's noise (as :func:`_value_noise` makes them)."""
     half = size / 2 / feature_length
     return half * 2 + 3 if half >= 1e15 else float(math.floor(half) - math.floor(-half) + 2)
+
+
+def check_image_budget(path: str, limits: Limits) -> None:
+    """ValueError (the rule) if the image's file or its pixels (from its header) are over the limits."""
+    size = os.path.getsize(path)
+    if size > limits.image_bytes:
+        raise ValueError(f"is a file of {size} bytes; at most {limits.image_bytes}")
+    width, height = image_size(path)
+    if width * height > limits.field_points:
+        raise ValueError(f"makes {width} x {height} grid points (its pixels); at most {limits.field_points}")

@@ -25,10 +25,10 @@ from thorvald_model.schema import Key
 from ..bodies import np, p, set_surface
 from ..geometry import Point, rectangle
 from ..kind import Context, ElementKind, Entry
-from ..limits import Limits, count_text, rounded
+from ..limits import count_text, rounded
 from ..rules import COORDINATE, HEIGHT, LENGTH, LENGTH_OR_ZERO, OPTIONAL_LENGTH, broken, file_path
 from ..surfaces import ZERO_HINT
-from ..terrain import field_heights, image_levels, image_size, noise_lattice, points
+from ..terrain import check_image_budget, field_heights, image_levels, noise_lattice, points
 
 CHECK = 1.0  # [m]: the side of a height field's checks, as the plane's
 TEXTURE_PIXELS_PER_CHECK = 4  # so the renderer's sampling keeps the checks' edges
@@ -188,16 +188,6 @@ def make(entry: Entry, context: Context) -> Optional[HeightField]:
             problems.append(Problem(f"{path}.feature_length", hf.feature_length, rule))
             return None
     return hf
-
-
-def check_image_budget(path: str, limits: Limits) -> None:
-    """ValueError (the rule) if the image's file or its pixels (from its header) are over the limits."""
-    size = os.path.getsize(path)
-    if size > limits.image_bytes:
-        raise ValueError(f"is a file of {size} bytes; at most {limits.image_bytes}")
-    width, height = image_size(path)
-    if width * height > limits.field_points:
-        raise ValueError(f"makes {width} x {height} grid points (its pixels); at most {limits.field_points}")
 
 
 def check(fields: Tuple[HeightField, ...], context: Context) -> None:

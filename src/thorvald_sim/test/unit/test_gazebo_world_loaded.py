@@ -1,0 +1,142 @@
+"""A Gazebo world file where a world is named (load_world, so the simulator node, run_robot and
+RobotSession): its ground plane our ground, its walls, poles and a crop mesh from GAZEBO_MODEL_PATH
+built as the Gazebo API's models, what it leaves out said once each; a robot driven in it is stopped
+by the wall it was written with."""
+
+import os
+
+import pytest
+
+from thorvald_sim.tools.runner import RobotSession, RunOptions
+from thorvald_sim.world import load_world
+
+CONFIGS = os.path.join(os.path.dirname(os.path.abspath(__file__)), *[".."] * 3, "thorvald_model", "config")
+STD = os.path.join(CONFIGS, "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
+
+FIELD = """<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="field">
+    <include><uri>model://sun</uri></include>
+    <include><uri>model://ground_plane</uri></include>
+    <physics type="ode">
+      <max_step_size>0.001</max_step_size><real_time_update_rate>1000</real_time_update_rate>
+    </physics>
+    <gravity>0 0 -9.8</gravity>
+    <scene><ambient>0.4 0.4 0.4 1</ambient></scene>
+    <model name="wall">
+      <static>true</static>
+      <pose>4 0 0.5 0 0 0</pose>
+      <link name="link">
+        <collision name="collision"><geometry><box><size>0.2 6 1</size></box></geometry></collision>
+        <visual name="visual"><geometry><box><size>0.2 6 1</size></box></geometry></visual>
+      </link>
+    </model>
+    <model name="pole">
+      <static>true</static>
+      <pose>-3 2 1 0 0 0</pose>
+      <link name="link">
+        <collision name="collision">
+          <geometry><cylinder><radius>0.05</radius><length>2</length></cylinder></geometry>
+        </collision>
+      </link>
+    </model>
+    <include><uri>model://crop</uri><name>crop_1</name><pose>-2 -2 0 0 0 0.3</pose></include>
+  </world>
+</sdf>
+"""
+
+CROP_CONFIG = """<?xml version="1.0"?>
+<model><name>crop</name><version>1.0</version><sdf version="1.6">model.sdf</sdf></model>
+"""
+CROP_SDF = """<?xml version="1.0"?>
+<sdf version="1.6"><model name="crop"><static>true</static><link name="link">
+  <collision name="collision"><geometry><mesh><uri>model://crop/meshes/crop.obj</uri><scale>1 1 2</scale></mesh>
+  </geometry></collision></link></model></sdf>
+"""
+# a pyramid 0.4 m wide and 0.25 m tall (0.5 m with the model's scale)
+CROP_OBJ = (
+    "v -0.2 -0.2 0\nv 0.2 -0.2 0\nv 0.2 0.2 0\nv -0.2 0.2 0\nv 0 0 0.25\n"
+    "f 1 3 2\nf 1 4 3\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n"
+)
+
+
+@pytest.fixture
+def field(tmp_path, monkeypatch):
+    crop = tmp_path / "models" / "crop"
+    (crop / "meshes").mkdir(parents=True)
+    (crop / "model.config").write_text(CROP_CONFIG)
+    (crop / "model.sdf").write_text(CROP_SDF)
+    (crop / "meshes" / "crop.obj").write_text(CROP_OBJ)
+    monkeypatch.setenv("GAZEBO_MODEL_PATH", str(tmp_path / "models"))
+    monkeypatch.setenv("HOME", str(tmp_path))  # no ~/.gazebo/models of this machine's
+    world = tmp_path / "field.world"
+    world.write_text(FIELD)
+    return str(world)
+
+
+def test_a_gazebo_world_loads_where_a_world_is_named(field):
+    world = load_world(field)
+    assert world.gravity == pytest.approx(9.8)
+    assert [m.name for m in world.models] == ["wall", "pole", "crop_1"]  # the ground plane is our ground
+    crop = world.models[2]
+    assert crop.static and crop.pose[0] == pytest.approx((-2.0, -2.0, 0.0))
+    mesh = crop.spec.links[0].collisions[0].geometry
+    assert mesh.path == os.path.join(os.path.dirname(field), "models", "crop", "meshes", "crop.obj")
+    assert tuple(mesh.scale) == (1.0, 1.0, 2.0)
+    said = "\n".join(world.notes)
+    assert "ground_plane" in said and "taken as the ground" in said
+    assert "scene" in said  # left out, and said
+    assert "sun" not in said  # a light Gazebo's worlds all include: nothing to say
+
+
+@pytest.mark.slow  # a drive of 6 simulated seconds
+def test_a_robot_driven_at_the_worlds_wall_is_stopped_by_it(field):
+    with RobotSession(STD, RunOptions(world=field)) as session:
+        gazebo = session.engine.gazebo
+        assert set(gazebo.models) == {"wall", "pole", "crop_1"}
+        (position, _), _, _ = gazebo.state("pole")
+        assert position == pytest.approx((-3.0, 2.0, 1.0), abs=1e-9)
+        session.run(6.0, lambda t: (0.8, 0.0, 0.0))  # 4.8 m ahead if nothing were in the way
+        x = session.pose()[0]
+    # the wall's face at x = 3.9; the standard robot's front reaches about 0.8 m ahead of base_link
+    assert 2.5 < x < 3.5, x
+
+
+HILL = """<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="hill">
+    <include><uri>model://sun</uri></include>
+    <model name="hill">
+      <static>true</static>
+      <link name="link">
+        <collision name="collision">
+          <geometry><heightmap><uri>file://hill.png</uri><size>8 8 2</size><pos>0 0 0</pos>
+            <sampling>1</sampling></heightmap></geometry>
+        </collision>
+      </link>
+    </model>
+  </world>
+</sdf>
+"""
+
+
+def test_a_heightmap_world_is_the_ground_gazebo_makes_of_its_image(tmp_path):
+    """An image that is not symmetric: its first row is the +y edge and its first column the -x edge,
+    a pixel's height its level over the brightest times size z, the grid centred on the origin and
+    size / (pixels - 1) apart (Gazebo's ODE heightmap)."""
+    from PIL import Image  # noqa: PLC0415
+
+    levels = [0] * 25
+    levels[0] = 255  # row 0, column 0: the (-x, +y) corner
+    levels[4 * 5 + 1] = 51  # row 4 (the -y edge), column 1
+    levels[2 * 5 + 3] = 102  # row 2 (y = 0), column 3
+    Image.frombytes("L", (5, 5), bytes(levels)).save(str(tmp_path / "hill.png"))
+    (tmp_path / "hill.world").write_text(HILL)
+    world = load_world(str(tmp_path / "hill.world"))
+    assert world.models == ()  # the model held the heightmap only
+    step = 8.0 / 4
+    assert world.ground_height(-4.0, 4.0) == pytest.approx(2.0, abs=1e-6)
+    assert world.ground_height(-4.0 + step, -4.0) == pytest.approx(51 / 255 * 2.0, abs=1e-6)
+    assert world.ground_height(-4.0 + 3 * step, 0.0) == pytest.approx(102 / 255 * 2.0, abs=1e-6)
+    assert world.ground_height(4.0, -4.0) == pytest.approx(0.0, abs=1e-6)
+    assert world.ground_height(4.0, 4.0) == pytest.approx(0.0, abs=1e-6)  # the mirror corner is black
