@@ -163,7 +163,11 @@ def test_a_missing_model_names_the_uri_and_every_folder_searched(tmp_path):
         f"{farm / 'models'} (gazebo_model_path of package farm_worlds)"
     )
     assert paths.model_sdf("model://crop") == (None, why)
-    assert gazebo().find_model("model://crop") == (None, "model://crop not found: no model folders")
+    assert gazebo().find_model("model://crop") == (
+        None,
+        "model://crop not found: no model folders (GAZEBO_MODEL_PATH is not set, there is no ~/.gazebo/models "
+        "and no package exports gazebo_model_path)",
+    )
 
 
 def test_every_folder_searched_is_said_in_order(tmp_path):

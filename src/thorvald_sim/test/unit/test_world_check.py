@@ -124,3 +124,55 @@ def test_the_command_needs_no_pybullet():
     )
     run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)
     assert run.stdout.splitlines()[-1] == "0 False"
+
+
+GAZEBO_WORLD = """<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="yard">
+    <include><uri>model://sun</uri></include>
+    <include><uri>model://ground_plane</uri></include>
+    <light type="point" name="lamp"><pose>0 0 3 0 0 0</pose></light>
+    <model name="post">
+      <static>true</static>
+      <pose>2 1 0.5 0 0 0</pose>
+      <link name="link"><collision name="c"><geometry><box><size>0.1 0.1 1</size></box></geometry></collision></link>
+    </model>
+    <model name="crate">
+      <pose>-2 0 0.2 0 0 0</pose>
+      <link name="link"><collision name="c"><geometry><box><size>0.4 0.4 0.4</size></box></geometry></collision></link>
+    </model>
+    {extra}
+  </world>
+</sdf>
+"""
+
+
+@pytest.mark.slow  # a process per case: the command as a user types it
+def test_a_gazebo_world_is_checked_as_ours(tmp_path, monkeypatch):
+    monkeypatch.setenv("HOME", str(tmp_path))  # no ~/.gazebo/models of this machine's
+    monkeypatch.delenv("GAZEBO_MODEL_PATH", raising=False)
+    path = tmp_path / "yard.world"
+    path.write_text(GAZEBO_WORLD.format(extra=""))
+    status, out, err = check_world(str(path))
+    assert (status, err) == (0, "")
+    lines = out.splitlines()
+    assert lines[:2] == [f"{path}: valid world", "  Gazebo world 'yard' (yard.world)"]
+    assert "  models    2 (1 static, 1 dynamic), actors 0" in lines
+    left_out = [line for line in lines if line.startswith("  left out  ")]
+    assert any("light 'lamp'" in line and "not simulated" in line for line in left_out), left_out
+    assert any("'ground_plane'" in line and "taken as the ground" in line for line in left_out), left_out
+    # every problem at once, each with its line and element path; a missing model names where it looked
+    path.write_text(
+        GAZEBO_WORLD.format(
+            extra="<include><uri>model://crop</uri></include>\n"
+            "    <model name='bad'><link name='l'><collision name='c'><geometry><box><size>1 -1 1</size>"
+            "</box></geometry></collision></link></model>"
+        )
+    )
+    status, out, err = check_world(str(path))
+    assert (status, out) == (2, "")
+    problems = err.splitlines()
+    assert problems[0] == f"{path}: invalid Gazebo world (2 problems):"
+    assert "line 16: world 'yard' > include" in problems[1] and "model://crop not found" in problems[1]
+    assert "GAZEBO_MODEL_PATH is not set" in problems[1]
+    assert "line 17: world 'yard' > model 'bad'" in problems[2] and "size" in problems[2]

@@ -288,7 +288,12 @@ class GazeboPaths:
 
     def _not_found(self, what: str, folders: Sequence[Folder], kind: str) -> str:
         if not folders:
-            return f"{what} not found: no {kind} folders" + self._problems()
+            where = {
+                "model": "GAZEBO_MODEL_PATH is not set, there is no ~/.gazebo/models and no package exports "
+                "gazebo_model_path",
+                "resource": "GAZEBO_RESOURCE_PATH is not set and no package exports gazebo_media_path",
+            }.get(kind, "")
+            return f"{what} not found: no {kind} folders ({where})" + self._problems()
         return f"{what} not found in: {_listing(folders)}" + self._problems()
 
     # ---- models -----------------------------------------------------------------------------------

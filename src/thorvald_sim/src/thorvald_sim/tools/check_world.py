@@ -1,9 +1,11 @@
 """``rosrun thorvald_sim check_world FILE [FILE ...]``: validates simulator world files.
 
-A FILE is a path or a shipped world's name (``flat``, ``crop_rows``, ...: see
-:func:`thorvald_sim.world.resolve_world`). The world is loaded as the simulator loads it, every
-rule and budget of :mod:`thorvald_sim.world` included, without starting the simulator (no
-pybullet). One valid file: a summary of the world (its elements, plants and extent). Several: one
+A FILE is a path, a shipped world's name (``flat``, ``crop_rows``, ...: see
+:func:`thorvald_sim.world.resolve_world`) or a Gazebo world (an SDF ``.world`` file, or a name on
+Gazebo's resource path such as ``worlds/farm.world``). The world is loaded as the simulator loads it,
+every rule and budget of :mod:`thorvald_sim.world` included, without starting the simulator (no
+pybullet). One valid file: a summary of the world (its elements, plants and extent; a Gazebo world's
+models and actors, and each kind of element it leaves out, with its element path). Several: one
 table row per world. Invalid files: every problem, one per line, on stderr, and exit status 2.
 """
 
@@ -56,6 +58,10 @@ def summary(world: WorldConfig) -> dict:
         "height_field": list(hf.grid_shape()) if hf is not None else None,
         "plants": plant_count(world),
         "extent": [round(v, 3) for v in box] if box is not None else None,
+        "models": len(world.models),  # a Gazebo world's
+        "static_models": sum(1 for m in world.models if m.static),
+        "actors": len(world.actors),
+        "notes": list(world.notes),
     }
 
 
@@ -87,6 +93,11 @@ def format_details(world: WorldConfig) -> str:
         f"  plants    {s['plants']}",
         f"  extent    {format_extent(s)}",
     ]
+    if s["models"] or s["actors"]:
+        dynamic = s["models"] - s["static_models"]
+        models = f"{s['models']} ({s['static_models']} static, {dynamic} dynamic)"
+        lines.append(f"  models    {models}, actors {s['actors']}")
+    lines += [f"  left out  {note}" for note in s["notes"]]
     return "\n".join(lines)
 
 

@@ -203,16 +203,28 @@ def shipped_worlds() -> List[str]:
 def resolve_world(name_or_path: str) -> str:
     """The file of a world given by name (a shipped world) or by path.
 
-    A shipped world's name wins over a file of that name in the current folder. Anything that looks
-    like a path (has a folder separator or a YAML extension) or names an existing file is returned
-    as it is, so that a missing file is reported by :func:`load_world` with the reason; a bare name
-    that is neither raises a ConfigError of one line listing the shipped worlds.
+    A shipped world's name wins over a file of that name in the current folder. An existing file is
+    returned as it is; a missing ``.world`` or ``.sdf`` is looked for as Gazebo looks for a world name
+    (``worlds/farm.world`` under ``GAZEBO_RESOURCE_PATH`` and the packages' ``gazebo_media_path``:
+    :meth:`~thorvald_sim.models.gazebo_paths.GazeboPaths.find_world`), a ConfigError naming every folder
+    searched when it is nowhere; anything else that looks like a path (a folder separator, a YAML
+    extension) is returned as it is, so that a missing file is reported by :func:`load_world` with the
+    reason; a bare name that is neither raises a ConfigError of one line listing the shipped worlds.
     """
     names = shipped_worlds()
     if name_or_path in names:
         return os.path.join(worlds_dir(), name_or_path + ".yaml")
+    if os.path.exists(name_or_path):
+        return name_or_path
+    if name_or_path.endswith((".world", ".sdf")):  # a Gazebo world's name: on Gazebo's resource path
+        from ..models.gazebo_paths import GazeboPaths  # noqa: PLC0415  (rospkg: only for such a name)
+
+        found, why = GazeboPaths().find_world(name_or_path)
+        if found is None:
+            raise ConfigError(name_or_path, [Problem("", MISSING, why)], WHAT)
+        return found
     looks_like_path = os.sep in name_or_path or name_or_path.endswith((".yaml", ".yml"))
-    if looks_like_path or os.path.exists(name_or_path):
+    if looks_like_path:
         return name_or_path
     rule = "no such world: give a file or one of " + ", ".join(names)
     raise ConfigError(name_or_path, [Problem("", MISSING, rule)], WHAT)
