@@ -128,6 +128,15 @@ class GazeboUsersTest(unittest.TestCase):
         sim_sleep(1.5)
         self.assertAlmostEqual(self.state("cap", "world").pose.position.z, 1.2, delta=0.02)  # 1 m + half of 0.4 m
 
+    def test_3c_the_world_files_models_are_models_of_the_api(self):
+        """yard.world's own models (its ground plane as the ground), where the file puts them."""
+        names = set(self.world().model_names)
+        self.assertTrue({"ground_plane", "yard_wall", "gate_post", "corner_post"} <= names, names)
+        self.assertAlmostEqual(self.state("yard_wall", "world").pose.position.x, 6.0, delta=1e-6)
+        corner = self.state("corner_post", "world").pose
+        self.assertAlmostEqual(corner.position.y, 4.0, delta=1e-6)
+        self.assertAlmostEqual(yaw_of(corner.orientation), 0.3, delta=1e-6)
+
     def test_4_the_turntable_joint_is_at_its_initial_position(self):
         response = self.joint("turn")
         self.assertTrue(response.success, response.status_message)
