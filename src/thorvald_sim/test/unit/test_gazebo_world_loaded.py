@@ -140,3 +140,49 @@ def test_a_heightmap_world_is_the_ground_gazebo_makes_of_its_image(tmp_path):
     assert world.ground_height(-4.0 + 3 * step, 0.0) == pytest.approx(102 / 255 * 2.0, abs=1e-6)
     assert world.ground_height(4.0, -4.0) == pytest.approx(0.0, abs=1e-6)
     assert world.ground_height(4.0, 4.0) == pytest.approx(0.0, abs=1e-6)  # the mirror corner is black
+
+
+WALKER = """<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="crossing">
+    <include><uri>model://ground_plane</uri></include>
+    <actor name="walker">
+      <pose>-3 2.5 0.9 0 0 0</pose>
+      <script>
+        <loop>false</loop>
+        <delay_start>1</delay_start>
+        <trajectory id="0" type="walking">
+          <waypoint><time>0</time><pose>-3 2.5 0.9 0 0 0</pose></waypoint>
+          <waypoint><time>6</time><pose>3 2.5 0.9 0 0 0</pose></waypoint>
+        </trajectory>
+      </script>
+    </actor>
+  </world>
+</sdf>
+"""
+
+
+@pytest.mark.slow  # 8 simulated seconds
+def test_an_actor_walks_its_script_and_the_world_sees_it_there(tmp_path):
+    """A person crossing in front of the robot: where its script has it, a body a ray (a lidar's
+    beam) meets there and nowhere else, standing where its script ends."""
+    from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
+
+    (tmp_path / "crossing.world").write_text(WALKER)
+    with RobotSession(STD, RunOptions(world=str(tmp_path / "crossing.world"))) as session:
+        gazebo = session.engine.gazebo
+
+        def beam():  # from beside the robot across the actor's path at x = 0, at chest height
+            hit = p.rayTest((0.0, 1.5, 1.2), (0.0, 4.0, 1.2), physicsClientId=session.client)[0]
+            return None if hit[0] < 0 else 2.5 * hit[2]
+
+        def x():
+            return gazebo.state("walker")[0][0][0]
+
+        session.run(0.5, lambda t: None)
+        assert x() == pytest.approx(-3.0, abs=1e-9) and beam() is None  # waiting out its delay_start
+        session.run(4.0, lambda t: None)  # 3 s into its 6 s walk: at x = 0
+        assert x() == pytest.approx(0.0, abs=0.02)
+        assert beam() == pytest.approx(2.5 - 1.5 - 0.25, abs=0.02)  # its near side, 0.25 m before its axis
+        session.run(8.0, lambda t: None)
+        assert x() == pytest.approx(3.0, abs=1e-9) and beam() is None  # at the end of its walk, staying

@@ -295,12 +295,22 @@ class GazeboApi:
         said once each. ConfigError naming the world file and the model a world cannot take."""
         for note in world.notes:
             rospy.logwarn("simulator: %s: %s", os.path.basename(world.source), note)
+        from ..world.gazebo_world import actor_model  # noqa: PLC0415  (a Gazebo world's only)
+
         for model in world.models:
             try:
                 self.add_spec(model.name, replace(model.spec, static=model.static), model.pose)
             except SpawnError as e:
                 problem = Problem(f"model '{model.name}'", model.spec.source, f"is built here: {e}")
                 raise ConfigError(world.source, [problem], WHAT) from None
+        for actor in world.actors:  # a static model in every world, moved by its script in each
+            try:
+                self.add_spec(actor.name, actor_model(actor), actor.pose_at(0.0))
+            except SpawnError as e:
+                problem = Problem(f"actor '{actor.name}'", world.source, f"is built here: {e}")
+                raise ConfigError(world.source, [problem], WHAT) from None
+            for worker in self.entities.model(actor.name).workers:
+                self.node.sim.ask(worker, ("animate", actor.name, actor))
 
     def model_path(self):
         """Gazebo's model path as this process's environment and the ROS packages' exports give it

@@ -62,7 +62,7 @@ class GazeboBodies:
 
     ASKED = (
         "state", "teleport", "link_properties", "joint_state", "configure", "gravity", "add_wrench",
-        "add_effort", "clear_wrenches", "clear_efforts", "spawn_model", "delete_model",
+        "add_effort", "clear_wrenches", "clear_efforts", "spawn_model", "delete_model", "animate",
     )  # fmt: skip
 
     def __init__(self, sim):
@@ -76,6 +76,9 @@ class GazeboBodies:
         # the static models' states as model_states last read them: nothing moves them but the requests
         # of MOVES and a reset, which forget them
         self.at_rest: Dict[str, Tuple[Pose, Vec3, Vec3]] = {}
+        # the actors of a Gazebo world: model name -> its Actor (thorvald_sim.world.gazebo_world), which puts
+        # the model where its script has it before every step
+        self.animated: Dict[str, object] = {}
 
     MOVES = ("teleport", "configure", "spawn_model", "delete_model")
 
@@ -135,6 +138,7 @@ class GazeboBodies:
         return self.describe(name, collisions)
 
     def delete_model(self, name: str) -> None:
+        self.animated.pop(name, None)
         model = self.models.pop(name)
         self.spawned.pop(name)
         model.remove()
@@ -315,8 +319,25 @@ class GazeboBodies:
     def clear_efforts(self, model: str, joint: Optional[int] = None) -> None:
         self.efforts = [j for j in self.efforts if not (j.model == model and joint in (None, j.index))]
 
+    def animate(self, name: str, actor) -> None:
+        """The model (a static one, built for it) follows the actor's script from now on: before every
+        step it is put where the script has it at the step's end, as Gazebo's actors are moved (not
+        pushed: a robot that meets one is pushed aside)."""
+        self.animated[name] = actor
+        self._place_actors(self.sim.time)
+
+    def _place_actors(self, t: float) -> None:
+        for name, actor in self.animated.items():
+            model = self.models.get(name)
+            if model is not None:
+                position, orientation = actor.pose_at(t)
+                model.set_pose(position, orientation)
+
     def before_step(self) -> None:
-        """The wrenches and efforts acting at this step's start (the simulated time now)."""
+        """The actors where their scripts have them at the step's end; the wrenches and efforts acting
+        at this step's start (the simulated time now)."""
+        if self.animated:
+            self._place_actors(self.sim.time + self.sim.dt)
         if not (self.wrenches or self.efforts):
             return
         now, c = self.sim.time, self.client
@@ -356,7 +377,7 @@ class GazeboBodies:
         models, per_link = {}, {}
         for name in list(self.sim.robots) + list(self.models):
             built = self.models.get(name)
-            if built is not None and built.static:  # where it was (10,000 plants cost one read each, once)
+            if built is not None and built.static and name not in self.animated:  # where it was (read once)
                 state = self.at_rest.get(name)
                 if state is None:
                     state = self.at_rest[name] = self.state(name)

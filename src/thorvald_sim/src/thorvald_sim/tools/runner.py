@@ -61,6 +61,7 @@ from ..physics.engine import Engine, WorldSettings
 from ..physics.presets import physics_settings
 from ..physics.robot import Pose2D, Vec3
 from ..world import WorldConfig, load_world, resolve_world
+from ..world.gazebo_world import actor_model
 from ..world.rules import WHAT as WORLD_WHAT
 
 WHAT = "list of commands"
@@ -286,6 +287,12 @@ class RobotSession:
                 if isinstance(built, str):
                     problem = Problem(f"model '{model.name}'", model.spec.source, f"is built here: {built}")
                     raise ConfigError(self.world.source, [problem], WORLD_WHAT)
+            for actor in self.world.actors:  # moved by their scripts, as in the simulator node
+                built = self.engine.gazebo.spawn_model(actor.name, actor_model(actor), actor.pose_at(0.0))
+                if isinstance(built, str):
+                    problem = Problem(f"actor '{actor.name}'", self.world.source, f"is built here: {built}")
+                    raise ConfigError(self.world.source, [problem], WORLD_WHAT)
+                self.engine.gazebo.animate(actor.name, actor)
             pose = Pose2D(options.x, options.y, options.z, options.yaw, options.roll, options.pitch)
             self.robot = self.sim.spawn(options.robot_name, urdf, pose, as_built)
             calculator = load_calculator(config, estimator=driver.estimator, projection=driver.projection)
@@ -392,7 +399,10 @@ class RobotSession:
 
     def _run(self, until, command, stop) -> bool:
         sim, robot, steps, clock, drives = self.sim, self.robot, self.steps, self.clock, self.drives
+        animated = self.engine.gazebo if self.engine.gazebo.animated else None  # a Gazebo world's actors
         while sim.time < until - 1e-9:
+            if animated is not None:
+                animated.before_step()
             if self._push is not None:
                 force, at = self._push
                 point, _ = p.multiplyTransforms(*robot.world_pose(), at, (0.0, 0.0, 0.0, 1.0))

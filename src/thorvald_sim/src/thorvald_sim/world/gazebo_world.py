@@ -319,6 +319,19 @@ class GazeboWorld:
         raise KeyError(name)
 
 
+def actor_model(actor: Actor) -> ModelSpec:
+    """The model an actor is simulated as: a static cylinder of its body's size, centred on its pose
+    (moved by its script: :meth:`thorvald_sim.gazebo.bodies.GazeboBodies.animate`)."""
+    radius, length = actor.body.radius, actor.body.length
+    shape = f"<geometry><cylinder><radius>{radius!r}</radius><length>{length!r}</length></cylinder></geometry>"
+    text = (
+        f"<sdf version='1.6'><model name='{actor.name}'><static>true</static><link name='body'>"
+        f"<collision name='body'>{shape}</collision><visual name='body'>{shape}"
+        "<material><diffuse>0.8 0.5 0.3 1</diffuse></material></visual></link></model></sdf>"
+    )
+    return parse_sdf_model(text, f"actor {actor.name}")
+
+
 # ---------------------------------------------------------------------------------------------
 # The entry points
 # ---------------------------------------------------------------------------------------------
