@@ -186,3 +186,16 @@ def test_an_actor_walks_its_script_and_the_world_sees_it_there(tmp_path):
         assert beam() == pytest.approx(2.5 - 1.5 - 0.25, abs=0.02)  # its near side, 0.25 m before its axis
         session.run(8.0, lambda t: None)
         assert x() == pytest.approx(3.0, abs=1e-9) and beam() is None  # at the end of its walk, staying
+
+
+@pytest.mark.slow  # 8 simulated seconds
+def test_an_actor_walking_into_a_standing_robot_pushes_it_along(tmp_path):
+    """An actor is moved, not pushed: a robot standing in its path is shoved ahead of it."""
+    path = tmp_path / "through.world"
+    path.write_text(WALKER.replace("-3 2.5 0.9", "-3 0 0.9").replace("3 2.5 0.9", "3 0 0.9"))
+    with RobotSession(STD, RunOptions(world=str(path))) as session:
+        session.run(1.0, lambda t: None)
+        assert abs(session.pose()[0]) < 0.01
+        session.run(8.0, lambda t: None)
+        # the walker ends at x = 3; the robot, its back against the walker's front, is beyond it
+        assert session.pose()[0] > 3.0, session.pose()
