@@ -199,3 +199,30 @@ def test_an_actor_walking_into_a_standing_robot_pushes_it_along(tmp_path):
         session.run(8.0, lambda t: None)
         # the walker ends at x = 3; the robot, its back against the walker's front, is beyond it
         assert session.pose()[0] > 3.0, session.pose()
+
+
+@pytest.mark.slow  # 6 simulated seconds
+def test_a_robot_on_a_heightmap_hill_stands_on_its_slope_and_climbs_it(tmp_path):
+    """A ramp image (each column brighter to the east): the robot put down at the origin at the height
+    the image gives there (as a users' spawn_model -z puts it: Gazebo does not lift a model out of a
+    heightmap) stands on it, pitched as the slope (0.1: 2 m over 20 m), and drives up it."""
+    import math  # noqa: PLC0415
+
+    from PIL import Image  # noqa: PLC0415
+
+    columns = [round(255 * c / 16) for c in range(17)]
+    Image.frombytes("L", (17, 17), bytes(columns * 17)).save(str(tmp_path / "hill.png"))
+    (tmp_path / "ramp.world").write_text(HILL.replace("<size>8 8 2</size>", "<size>20 20 2</size>"))
+    ground = columns[8] / 255 * 2.0  # at the origin: the middle column's level, of the brightest's 2 m
+    with RobotSession(STD, RunOptions(world=str(tmp_path / "ramp.world"), z=ground + 0.1)) as session:
+        session.run(1.0, lambda t: None)
+        x0, _, z0, _, pitch, _ = session.pose()
+        assert pitch == pytest.approx(-math.atan(0.1), abs=0.01)  # nose up, facing uphill
+        # base_link stands as high above the ground as on the flat, the ground 1 m up here (the middle)
+        with RobotSession(STD, RunOptions()) as flat:
+            flat.run(1.0, lambda t: None)
+            above = flat.pose()[2]
+        assert z0 == pytest.approx(ground + above, abs=0.05)
+        session.run(6.0, lambda t: (0.5, 0.0, 0.0))
+        x1, _, z1, _, _, _ = session.pose()
+    assert x1 - x0 > 1.5 and z1 - z0 == pytest.approx(0.1 * (x1 - x0), abs=0.03)
