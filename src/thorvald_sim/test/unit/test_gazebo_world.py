@@ -21,7 +21,8 @@ from models_fixtures import write_obj
 from thorvald_model.errors import ConfigError
 from thorvald_sim.models.gazebo_paths import GazeboPaths
 from thorvald_sim.models.spec import Box, Cylinder, Mesh, Plane
-from thorvald_sim.world.gazebo_world import PERSON, is_gazebo_world, read_gazebo_world
+from thorvald_sim.world.gazebo_actors import PERSON
+from thorvald_sim.world.gazebo_world import is_gazebo_world, read_gazebo_world
 from thorvald_sim.world.limits import Limits
 
 IDENTITY_Q = (0.0, 0.0, 0.0, 1.0)

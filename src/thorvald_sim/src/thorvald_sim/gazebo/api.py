@@ -295,7 +295,7 @@ class GazeboApi:
         said once each. ConfigError naming the world file and the model a world cannot take."""
         for note in world.notes:
             rospy.logwarn("simulator: %s: %s", os.path.basename(world.source), note)
-        from ..world.gazebo_world import actor_model  # noqa: PLC0415  (a Gazebo world's only)
+        from ..world.gazebo_actors import actor_model  # noqa: PLC0415  (a Gazebo world's only)
 
         for model in world.models:
             try:

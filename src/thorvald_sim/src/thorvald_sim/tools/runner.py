@@ -61,7 +61,7 @@ from ..physics.engine import Engine, WorldSettings
 from ..physics.presets import physics_settings
 from ..physics.robot import Pose2D, Vec3
 from ..world import WorldConfig, load_world, resolve_world
-from ..world.gazebo_world import actor_model
+from ..world.gazebo_actors import actor_model
 from ..world.rules import WHAT as WORLD_WHAT
 
 WHAT = "list of commands"

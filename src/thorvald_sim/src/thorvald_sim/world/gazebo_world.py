@@ -6,9 +6,10 @@ only, imported when one is read).
 
 :func:`read_gazebo_world` reads it; :func:`is_gazebo_world` tells such a file from our YAML worlds by
 its first bytes. Models are read by :func:`thorvald_sim.models.sdf.parse_sdf_model`, found through
-:class:`thorvald_sim.models.gazebo_paths.GazeboPaths`; a heightmap becomes our
-:class:`~thorvald_sim.world.kinds.height_field.HeightField` through
-:func:`thorvald_sim.world.gazebo_heightmap.as_height_field`.
+:class:`thorvald_sim.models.gazebo_paths.GazeboPaths`; a heightmap becomes our height field's keys
+through :func:`thorvald_sim.world.gazebo_heightmap.as_height_field` (the loader makes the field:
+:func:`thorvald_sim.world.loader.gazebo_world_config`); actors are :mod:`~thorvald_sim.world.gazebo_actors`'
+and populations' places :mod:`~thorvald_sim.world.gazebo_population`'s.
 
 What Gazebo 11 does, and what is done here (files named are gazebo-classic's, the gazebo11 branch,
 unless another project is named: sdformat 9, ignition-math 6)
@@ -79,7 +80,7 @@ unless another project is named: sdformat 9, ignition-math 6)
    waypoint. :meth:`Actor.pose_at` gives that pose for the sim time t, continuously (Gazebo moves an
    actor at most every 1/30 s of sim time), as Gazebo sets it for an actor without a skin (a skin's
    root bone adds its animation's offset). Its body here is a person-sized cylinder
-   (:data:`PERSON`); whether its skin was found is recorded.
+   (:data:`~thorvald_sim.world.gazebo_actors.PERSON`); whether its skin was found is recorded.
 7. Heightmaps (``gazebo/physics/HeightmapShape.cc``; the convention of
    :mod:`~thorvald_sim.world.gazebo_heightmap`): a ``<collision>`` of ``<heightmap>`` geometry, in a
    ``<model>`` of the world or in an included model file (its image found from that file's folder,
@@ -108,14 +109,13 @@ for includes within includes) are checked before what they count is made. A recu
 is refused with its chain; a model that cannot be found names its URI and every folder searched.
 """
 
-import bisect
 import math
 import os
 import random
 import re
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass, field, replace
-from typing import Any, Dict, Iterable, List, Optional, Sequence, Set, Tuple
+from dataclasses import dataclass, replace
+from typing import Any, Dict, List, Optional, Sequence, Set, Tuple
 from xml.parsers import expat
 
 from thorvald_model.datum import Datum
@@ -125,7 +125,9 @@ from ..errors import ModelError
 from ..models import reading
 from ..models.gazebo_paths import GazeboPaths, included_kind
 from ..models.sdf import LATEST, parse_sdf_model
-from ..models.spec import IDENTITY, Cylinder, Mesh, ModelSpec, Pose, Vec3, compose, pose_from_xyz_rpy, tree
+from ..models.spec import IDENTITY, Mesh, ModelSpec, Pose, Vec3, compose, pose_from_xyz_rpy, tree
+from .gazebo_actors import Actor, Trajectory, trajectory
+from .gazebo_population import POPULATION_TYPES, population_count, population_places
 from .limits import LIMITS, Limits
 from .terrain import check_image_budget, image_size
 
@@ -141,15 +143,6 @@ REAL_TIME_FACTOR = 1.0
 GRAVITY: Vec3 = (0.0, 0.0, -9.8)  # [m/s^2]
 SURFACE_MODEL = "EARTH_WGS84"
 
-PERSON = Cylinder(0.25, 1.8)  # [m] an actor's body here: a person-sized cylinder, centred on its pose
-POPULATION_TYPES = ("random", "uniform", "grid", "linear-x", "linear-y", "linear-z")
-UNIFORM_STEP = 0.1  # [m] Population::CreatePosesBoxUniform's observations, over the box's x and y
-UNIFORM_CYLINDER_POINTS = 10000  # Population::CreatePosesCylinderUniform's observations
-MAX_KMEANS_OBSERVATIONS = 1_000_000  # of a uniform population's k-means (Gazebo's: one every 0.1 m of its box)
-MAX_KMEANS_WORK = 20_000_000  # observations times clusters of a uniform population (each k-means pass)
-MAX_KMEANS_PASSES = 1000
-EPSILON = 1e-6  # ignition::math::equal's default tolerance
-CLOSE = 1e-3  # ignition-math's == of vectors and quaternions (each component)
 SUN = "model://sun"
 
 # What the simulator leaves out, by world element: one note a kind
@@ -215,82 +208,6 @@ class WorldModel:
 
 
 @dataclass(frozen=True)
-class Trajectory:
-    """One ``<trajectory>`` of an actor's script, as Gazebo keys it: ``times`` sorted, the first 0, and
-    the pose at each (``poses``), with the splines' tangents; it lasts ``duration`` (its last waypoint's
-    time) from ``start`` in the script. A trajectory without waypoints plays a skeleton animation
-    only (``times`` empty)."""
-
-    id: int
-    type: str
-    times: Tuple[float, ...]
-    poses: Tuple[Pose, ...]
-    duration: float
-    start: float = 0.0
-    position_tangents: Tuple[Vec3, ...] = field(default=(), repr=False)
-    rotation_tangents: Tuple[Tuple[float, float, float, float], ...] = field(default=(), repr=False)
-
-    @property
-    def end(self) -> float:
-        return self.start + self.duration
-
-    def pose_at(self, time: float) -> Pose:
-        """The pose ``time`` [s] after the trajectory's start (clamped to it), as Gazebo's
-        ``PoseAnimation`` interpolates it; the origin for a trajectory without waypoints (Gazebo's
-        default pose, which it sets when there is no skeleton animation to add)."""
-        if not self.times:
-            return IDENTITY
-        return _keyframe_pose(self, min(max(time, 0.0), self.duration))
-
-
-@dataclass(frozen=True)
-class Actor:
-    """An ``<actor>``: its own ``pose`` (where it stands before and without its script), its
-    ``skin`` (as written; ``skin_path``: the file found, or None), and its script."""
-
-    name: str
-    pose: Pose
-    skin: str = ""
-    skin_path: Optional[str] = None
-    skin_scale: float = 1.0
-    loop: bool = True
-    delay_start: float = 0.0  # [s]
-    auto_start: bool = True
-    trajectories: Tuple[Trajectory, ...] = ()
-    body: Cylinder = PERSON
-
-    @property
-    def script_length(self) -> float:
-        return sum(t.duration for t in self.trajectories)
-
-    def pose_at(self, t: float) -> Pose:
-        """The actor's pose at sim time t [s] as Gazebo 11's ``Actor::Update`` sets it (continuously:
-        Gazebo does it every 1/30 s at most; without a skin's root bone offset)."""
-        if not self.auto_start or not any(tr.times for tr in self.trajectories):
-            return self.pose  # nothing plays it (a plugin would), or nothing moves it
-        length = self.script_length
-        s = t - self.delay_start
-        if s < 0:
-            return self.pose
-        if length <= 0:
-            return next(tr.poses[0] for tr in self.trajectories if tr.times)
-        if s >= length:
-            if not self.loop:
-                return self._script_pose(length)
-            # each cycle waits delay_start again at the script's first pose (set when it wrapped)
-            s = math.fmod(s, length + self.delay_start)
-            if s >= length:
-                return self._script_pose(0.0)
-        return self._script_pose(s)
-
-    def _script_pose(self, s: float) -> Pose:
-        for trajectory in self.trajectories:
-            if trajectory.start <= s <= trajectory.end:
-                return trajectory.pose_at(s - trajectory.start)
-        return self.pose
-
-
-@dataclass(frozen=True)
 class GazeboWorld:
     """A Gazebo world file, read (:func:`read_gazebo_world`)."""
 
@@ -317,19 +234,6 @@ class GazeboWorld:
             if model.name == name:
                 return model
         raise KeyError(name)
-
-
-def actor_model(actor: Actor) -> ModelSpec:
-    """The model an actor is simulated as: a static cylinder of its body's size, centred on its pose
-    (moved by its script: :meth:`thorvald_sim.gazebo.bodies.GazeboBodies.animate`)."""
-    radius, length = actor.body.radius, actor.body.length
-    shape = f"<geometry><cylinder><radius>{radius!r}</radius><length>{length!r}</length></cylinder></geometry>"
-    text = (
-        f"<sdf version='1.6'><model name='{actor.name}'><static>true</static><link name='body'>"
-        f"<collision name='body'>{shape}</collision><visual name='body'>{shape}"
-        "<material><diffuse>0.8 0.5 0.3 1</diffuse></material></visual></link></model></sdf>"
-    )
-    return parse_sdf_model(text, f"actor {actor.name}")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -746,7 +650,7 @@ class _Reader:
             if child.tag in ("model", "include", "actor"):
                 shares.append((child, 1))
             elif child.tag == "population":
-                shares.append((child, _population_count(child)))
+                shares.append((child, population_count(child)))
         total = sum(n for _, n in shares) + 1
         if total <= self.limits.bodies:
             return
@@ -1084,7 +988,7 @@ class _Reader:
         spec = self.population_spec(models[0])
         if spec is None or params is None or len(self.problems) > before or self.over_budget:
             return
-        places = _population_places(params, random.Random(f"{self.seed}:{index}:{element.get('name', '')}"))
+        places = population_places(params, random.Random(f"{self.seed}:{index}:{element.get('name', '')}"))
         if isinstance(places, str):
             self.problem(element, places)
             return
@@ -1203,15 +1107,15 @@ class _Reader:
                 self.note(skin_element, f"skin {skin!r} not found ({why}): the actor follows its script without it")
         script = element.find("script")
         trajectories: List[Trajectory] = []
-        for trajectory in script.findall("trajectory") if script is not None else ():
-            made = self.trajectory(trajectory)
+        for written in script.findall("trajectory") if script is not None else ():
+            made = self.trajectory(written)
             if made is not None:
                 trajectories.append(made)
         trajectories.sort(key=lambda t: t.id)  # stable: Gazebo inserts one after those of its id
         start = 0.0
-        for i, trajectory in enumerate(trajectories):
-            trajectories[i] = replace(trajectory, start=start)
-            start += trajectory.duration
+        for i, played in enumerate(trajectories):
+            trajectories[i] = replace(played, start=start)
+            start += played.duration
         for child in script if script is not None else ():
             if child.tag not in ("loop", "delay_start", "auto_start", "trajectory"):
                 self.note(child, "not an element of an actor's script (ignored)", ("script", "?"))
@@ -1245,7 +1149,7 @@ class _Reader:
         if not points:
             self.note(element, "a trajectory without waypoints plays a skeleton animation only: it does not move")
             return Trajectory(int(text), kind, (), (), 0.0)
-        return _trajectory(int(text), kind, sorted(points.items()))
+        return trajectory(int(text), kind, sorted(points.items()))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1283,321 +1187,3 @@ def _find(model: ET.Element, path: str) -> ET.Element:
             break
         at = found
     return at
-
-
-def _population_count(element: ET.Element) -> int:
-    """The instances a population makes, from its text alone (rows x cols of a grid, else model_count;
-    1 where it cannot be read: its problem is reported when it is read)."""
-
-    def whole(parent: Optional[ET.Element], tag: str) -> int:
-        text = ((parent.findtext(tag) if parent is not None else None) or "").strip()
-        return max(int(text), 0) if re.fullmatch(r"[+-]?\d+", text) else 1
-
-    distribution = element.find("distribution")
-    kind = ((distribution.findtext("type") if distribution is not None else None) or "random").strip()
-    if kind == "grid":
-        return whole(distribution, "rows") * whole(distribution, "cols")
-    return whole(element, "model_count")
-
-
-def _population_places(params: Dict[str, Any], rng: random.Random):
-    """The clones' positions as Population.cc makes them (module docstring, item 5), or why not."""
-    kind = params["type"]
-    pose = params["pose"]
-    (px, py, pz), rotation = pose
-    if kind == "grid":
-        rows, cols, (sx, sy, _) = params["rows"], params["cols"], params["step"]
-        px -= sx * (cols - 2) / 2.0 + sx / 2.0 if cols % 2 == 0 else sx * (cols - 1) / 2.0
-        py -= sy * (rows - 2) / 2.0 + sy / 2.0 if rows % 2 == 0 else sy * (rows - 1) / 2.0
-        offsets: Iterable[Vec3] = ((j * sx, i * sy, 0.0) for i in range(rows) for j in range(cols))
-    else:
-        count = params["count"]
-        if params["region"] == "box":
-            size = params["size"]
-            px, py, pz = px - size[0] / 2.0, py - size[1] / 2.0, pz - size[2] / 2.0
-            if kind == "random":
-                offsets = [
-                    (rng.uniform(0, size[0]), rng.uniform(0, size[1]), rng.uniform(0, size[2])) for _ in range(count)
-                ]
-            elif kind == "uniform":
-                points = _box_observations(size, rng)
-                if isinstance(points, str):
-                    return points
-                offsets = points
-            else:
-                axis = "xyz".index(kind[-1])
-                half = [size[0] / 2.0, size[1] / 2.0, size[2] / 2.0]
-                offsets = []
-                for i in range(count):
-                    offset = list(half)
-                    offset[axis] = size[axis] * i / float(count)
-                    offsets.append((offset[0], offset[1], offset[2]))
-        else:
-            radius, length = params["radius"], params["length"]
-
-            def in_cylinder() -> Vec3:
-                angle, r = rng.uniform(0, 2 * math.pi), rng.uniform(0, radius)
-                return (r * math.cos(angle), r * math.sin(angle), rng.uniform(0, length))
-
-            if kind == "random":
-                offsets = [in_cylinder() for _ in range(count)]
-            else:
-                offsets = [in_cylinder() for _ in range(UNIFORM_CYLINDER_POINTS)]
-        if kind == "uniform":
-            offsets = _kmeans(offsets, count)
-            if isinstance(offsets, str):
-                return offsets
-    return [_add(_rotate(rotation, offset), (px, py, pz)) for offset in offsets]
-
-
-def _box_observations(size: Vec3, rng: random.Random):
-    """CreatePosesBoxUniform's observations (numpy, n x 3): every 0.1 m over x (inner) and y, counted
-    as Gazebo counts (x += .1 while below the size), each at a random height; or why not."""
-    import numpy as np  # noqa: PLC0415  (a uniform population only)
-
-    estimate = (math.ceil(size[0] / UNIFORM_STEP) + 1) * (math.ceil(size[1] / UNIFORM_STEP) + 1)
-    if estimate > MAX_KMEANS_OBSERVATIONS:
-        return (
-            f"a uniform population over {size[0]:g} x {size[1]:g} m: Gazebo's k-means would cluster about "
-            f"{estimate} observations (one every {UNIFORM_STEP:g} m); at most {MAX_KMEANS_OBSERVATIONS} here"
-        )
-
-    def steps(length: float) -> List[float]:
-        values, at = [], 0.0
-        while at < length:
-            values.append(at)
-            at += UNIFORM_STEP
-        return values
-
-    xs, ys = steps(size[0]), steps(size[1])
-    grid_x, grid_y = np.meshgrid(np.asarray(xs), np.asarray(ys))  # rows of y, x inner
-    heights = np.asarray([rng.uniform(0, size[2]) for _ in range(grid_x.size)])
-    return np.column_stack([grid_x.ravel(), grid_y.ravel(), heights])
-
-
-def _kmeans(points, k: int):
-    """ignition-math's Kmeans::Cluster on points (n x 3): the centroids, or why not."""
-    import numpy as np  # noqa: PLC0415  (a uniform population only)
-
-    obs = np.asarray(points, dtype=np.float64)
-    if k > len(obs):
-        return f"model_count {k} is more than the {len(obs)} k-means observations Gazebo makes of the region"
-    if len(obs) * k > MAX_KMEANS_WORK:
-        return f"model_count {k} over {len(obs)} observations: more k-means work than {MAX_KMEANS_WORK} a pass"
-    centroids = obs[:k].copy()
-    labels = np.zeros(len(obs), dtype=np.int64)
-    chunk = max(1, 2**18 // k)
-    for _ in range(MAX_KMEANS_PASSES):
-        new = np.empty_like(labels)
-        for at in range(0, len(obs), chunk):
-            part = obs[at : at + chunk]
-            distances = np.sqrt(((part[:, None, :] - centroids[None, :, :]) ** 2).sum(axis=2))
-            new[at : at + chunk] = distances.argmin(axis=1)  # the first of equals, as ClosestCentroid
-        changed = int((new != labels).sum())
-        labels = new
-        counts = np.bincount(labels, minlength=k)
-        if (counts == 0).any():
-            return "Gazebo's k-means leaves a cluster empty for this region and count (its centroid is not a number)"
-        sums = np.zeros((k, 3))
-        np.add.at(sums, labels, obs)
-        centroids = sums / counts[:, None]
-        if changed <= len(obs) >> 10:
-            break
-    return [(float(c[0]), float(c[1]), float(c[2])) for c in centroids]
-
-
-def _rotate(q, v: Vec3) -> Vec3:
-    x, y, z, w = q
-    vx, vy, vz = v
-    # v + 2 w (u x v) + 2 u x (u x v), u the vector part
-    cx, cy, cz = y * vz - z * vy, z * vx - x * vz, x * vy - y * vx
-    return (
-        vx + 2 * (w * cx + y * cz - z * cy),
-        vy + 2 * (w * cy + z * cx - x * cz),
-        vz + 2 * (w * cz + x * cy - y * cx),
-    )
-
-
-def _add(a: Vec3, b: Vec3) -> Vec3:
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-# ---------------------------------------------------------------------------------------------
-# An actor's trajectory: ignition-math 6's splines, as Gazebo's PoseAnimation uses them
-# ---------------------------------------------------------------------------------------------
-_Quat = Tuple[float, float, float, float]  # (w, x, y, z): ignition-math's order, here only
-
-
-def _trajectory(id_: int, kind: str, points: List[Tuple[float, Pose]]) -> Trajectory:
-    """A trajectory of (time, pose) sorted by time: the first key moved to time 0 (Actor::LoadScript),
-    the keys in order of time (CreateKeyFrame's upper_bound), the splines' tangents made once."""
-    duration = points[-1][0]
-    keys = [(0.0 if i == 0 and abs(t) > EPSILON else t, pose) for i, (t, pose) in enumerate(points)]
-    keys.sort(key=lambda k: k[0])
-    positions = [pose[0] for _, pose in keys]
-    rotations = [_wxyz(pose[1]) for _, pose in keys]
-    return Trajectory(
-        id_,
-        kind,
-        tuple(t for t, _ in keys),
-        tuple(pose for _, pose in keys),
-        duration,
-        position_tangents=tuple(_position_tangents(positions)),
-        rotation_tangents=tuple(_rotation_tangents(rotations)),
-    )
-
-
-def _keyframe_pose(trajectory: Trajectory, time: float) -> Pose:
-    """PoseAnimation::GetInterpolatedKeyFrame: the keys around time (Animation::GetKeyFramesAtTime),
-    the fraction of the time between them, the splines from the first."""
-    times = trajectory.times
-    j = bisect.bisect_left(times, time)  # the first key at or after time
-    if j == len(times):
-        t2 = trajectory.duration + times[0]  # none after it: "wrap back to the first"
-        j -= 1
-    else:
-        t2 = times[j]
-        if j != 0 and time < times[j]:
-            j -= 1
-    t1 = times[j]
-    t = 0.0 if abs(t1 - t2) <= EPSILON else (time - t1) / (t2 - t1)
-    if abs(t) <= EPSILON:
-        return trajectory.poses[j]
-    return (_position(trajectory, j, t), _xyzw(_rotation(trajectory, j, t)))
-
-
-def _position_tangents(points: List[Vec3]) -> List[Vec3]:
-    """Spline::RecalcTangents, tension 0: Catmull-Rom; an end's from its one neighbour, or (the ends
-    equal within 1e-3: closed) the other end's."""
-    n = len(points)
-    if n < 2:
-        return [(0.0, 0.0, 0.0)] * n
-    closed = all(abs(a - b) <= CLOSE for a, b in zip(points[0], points[-1]))
-
-    def half(a: Vec3, b: Vec3) -> Vec3:
-        return ((a[0] - b[0]) * 0.5, (a[1] - b[1]) * 0.5, (a[2] - b[2]) * 0.5)
-
-    tangents = []
-    for i in range(n):
-        if i == 0:
-            tangents.append(half(points[1], points[n - 2] if closed else points[0]))
-        elif i == n - 1:
-            tangents.append(tangents[0] if closed else half(points[i], points[i - 1]))
-        else:
-            tangents.append(half(points[i + 1], points[i - 1]))
-    return tangents
-
-
-def _position(trajectory: Trajectory, i: int, t: float) -> Vec3:
-    """Spline::Interpolate(i, t): the cubic Hermite segment from key i (key i itself past the last)."""
-    points = [pose[0] for pose in trajectory.poses]
-    if i + 1 >= len(points):
-        return points[i]
-    p0, p1 = points[i], points[i + 1]
-    m0, m1 = trajectory.position_tangents[i], trajectory.position_tangents[i + 1]
-    t2, t3 = t * t, t * t * t
-    h00, h01, h10, h11 = 2 * t3 - 3 * t2 + 1, -2 * t3 + 3 * t2, t3 - 2 * t2 + t, t3 - t2
-    return tuple(h00 * a + h01 * b + h10 * c + h11 * d for a, b, c, d in zip(p0, p1, m0, m1))  # type: ignore[return-value]
-
-
-def _rotation_tangents(points: List[_Quat]) -> List[_Quat]:
-    """RotationSpline::RecalcTangents (Shoemake): p exp(-(log(p^-1 next) + log(p^-1 previous)) / 4)."""
-    n = len(points)
-    if n < 2:
-        return list(points)
-    closed = all(abs(a - b) <= CLOSE for a, b in zip(points[0], points[-1]))
-    tangents = []
-    for i, p in enumerate(points):
-        inverse = _qinverse(p)
-        if i == 0:
-            part1 = _qlog(_qmul(inverse, points[1]))
-            part2 = _qlog(_qmul(inverse, points[n - 2] if closed else p))
-        elif i == n - 1:
-            part1 = _qlog(_qmul(inverse, points[1] if closed else p))
-            part2 = _qlog(_qmul(inverse, points[i - 1]))
-        else:
-            part1 = _qlog(_qmul(inverse, points[i + 1]))
-            part2 = _qlog(_qmul(inverse, points[i - 1]))
-        tangents.append(_qmul(p, _qexp(tuple((a + b) * -0.25 for a, b in zip(part1, part2)))))  # type: ignore[arg-type]
-    return tangents
-
-
-def _rotation(trajectory: Trajectory, i: int, t: float) -> _Quat:
-    """RotationSpline::Interpolate(i, t, shortest path): squad between keys i and i + 1."""
-    points = [_wxyz(pose[1]) for pose in trajectory.poses]
-    if i + 1 >= len(points):
-        return points[i]
-    if abs(t) <= EPSILON:
-        return points[i]
-    if abs(t - 1.0) <= EPSILON:
-        return points[i + 1]
-    a, b = trajectory.rotation_tangents[i], trajectory.rotation_tangents[i + 1]
-    return _squad(t, points[i], a, b, points[i + 1], shortest=True)
-
-
-def _squad(t: float, p: _Quat, a: _Quat, b: _Quat, q: _Quat, *, shortest: bool) -> _Quat:
-    return _slerp(2.0 * t * (1.0 - t), _slerp(t, p, q, shortest), _slerp(t, a, b, False), False)
-
-
-def _slerp(t: float, p: _Quat, q: _Quat, shortest: bool) -> _Quat:
-    """Quaternion::Slerp: the standard slerp, or (within 1e-3 of the same or opposite) a normalised lerp."""
-    cos = sum(a * b for a, b in zip(p, q))
-    if cos < 0.0 and shortest:
-        cos, q = -cos, (-q[0], -q[1], -q[2], -q[3])
-    if abs(cos) < 1 - 1e-3:
-        sin = math.sqrt(1 - cos * cos)
-        angle = math.atan2(sin, cos)
-        c0, c1 = math.sin((1.0 - t) * angle) / sin, math.sin(t * angle) / sin
-        return (p[0] * c0 + q[0] * c1, p[1] * c0 + q[1] * c1, p[2] * c0 + q[2] * c1, p[3] * c0 + q[3] * c1)
-    mixed = tuple(a * (1.0 - t) + b * t for a, b in zip(p, q))
-    norm = math.sqrt(sum(c * c for c in mixed))
-    if norm <= EPSILON:
-        return (1.0, 0.0, 0.0, 0.0)
-    return (mixed[0] / norm, mixed[1] / norm, mixed[2] / norm, mixed[3] / norm)
-
-
-def _qmul(a: _Quat, b: _Quat) -> _Quat:
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    return (
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    )
-
-
-def _qinverse(q: _Quat) -> _Quat:
-    s = sum(c * c for c in q)
-    if abs(s) <= EPSILON:
-        return (1.0, 0.0, 0.0, 0.0)
-    return (q[0] / s, -q[1] / s, -q[2] / s, -q[3] / s)
-
-
-def _qlog(q: _Quat) -> _Quat:
-    w, x, y, z = q
-    if abs(w) < 1.0:
-        angle = math.acos(w)
-        sin = math.sin(angle)
-        if abs(sin) >= 1e-3:
-            c = angle / sin
-            return (0.0, c * x, c * y, c * z)
-    return (0.0, x, y, z)
-
-
-def _qexp(q: _Quat) -> _Quat:
-    _, x, y, z = q
-    angle = math.sqrt(x * x + y * y + z * z)
-    sin = math.sin(angle)
-    if abs(sin) >= 1e-3:
-        c = sin / angle
-        return (math.cos(angle), c * x, c * y, c * z)
-    return (math.cos(angle), x, y, z)
-
-
-def _wxyz(q) -> _Quat:
-    return (q[3], q[0], q[1], q[2])
-
-
-def _xyzw(q: _Quat):
-    return (q[1], q[2], q[3], q[0])
