@@ -87,6 +87,7 @@ def test_a_gazebo_world_loads_where_a_world_is_named(field):
     assert "ground_plane" in said and "taken as the ground" in said
     assert "scene" in said  # left out, and said
     assert "sun" not in said  # a light Gazebo's worlds all include: nothing to say
+    assert "physics: Gazebo's steps of 0.001 s, 1000 a second (at 1 x real time), are not taken" in said
 
 
 @pytest.mark.slow  # a drive of 6 simulated seconds

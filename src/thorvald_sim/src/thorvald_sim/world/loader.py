@@ -73,6 +73,11 @@ def gazebo_world_config(world, limits: Limits = LIMITS) -> WorldConfig:
         data["height_field"] = world.height_field
     config = parse_world(data, world.source, folder, limits)
     models, notes = [], list(world.notes)
+    pace = "as fast as it can" if world.real_time_update_rate <= 0 else f"at {world.real_time_factor:g} x real time"
+    notes.append(
+        f"physics: Gazebo's steps of {world.max_step_size:g} s, {world.real_time_update_rate:g} a second ({pace}), "
+        "are not taken: the simulator steps at its ~physics_rate and keeps its ~real_time_factor"
+    )
     for model in world.models:
         if _is_ground_plane(model):
             notes.append(f"model {model.name!r}: a plane facing up at z = 0, taken as the ground (our ground's)")
