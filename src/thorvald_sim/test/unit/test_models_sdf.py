@@ -190,6 +190,26 @@ def test_includes_through_the_callers_loader():
     assert "no loader" in str(refused(text))
 
 
+def test_a_model_wrapping_static_models_only_is_static():
+    """Gazebo's populations wrap the model they replicate (``<model name="can"><include>...``): each
+    included model keeps its own static; a wrapper of static models only is static here (one of static
+    and moving models is one moving model here, refused unless joints join its links)."""
+
+    def include(uri):
+        static = uri == "model://post"
+        return (box_sdf(name=uri[8:], static=static), f"/models/{uri[8:]}/model.sdf"), ""
+
+    wrapper = "<sdf version='1.6'><model name='w'>{}</model></sdf>"
+    post = "<include><uri>model://post</uri></include>"
+    crate = "<include><uri>model://crate</uri></include>"
+    assert parse_sdf_model(wrapper.format(post), "w", include=include).static
+    with_static = "<include><uri>model://crate</uri><static>true</static></include>"
+    assert parse_sdf_model(wrapper.format(with_static), "w", include=include).static
+    assert not parse_sdf_model(wrapper.format(crate), "w", include=include).static
+    mixed = refused(wrapper.format(post + crate.replace("<uri>", "<name>c</name><uri>")), include=include)
+    assert "links that no joint connects" in str(mixed)
+
+
 def test_a_bare_model_and_a_newer_version():
     bare = parse_sdf_model("<model name='m'><link name='l'/></model>", "m")
     assert bare.links[0].name == "l"

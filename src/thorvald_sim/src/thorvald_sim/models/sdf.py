@@ -298,6 +298,8 @@ class _Reader:
                 scope.joints.append(replace(joint, name=prefix + joint.name, parent=parent, child=prefix + joint.child))
             if canonical is None and inner.links:
                 canonical = prefix + inner.links[0].name
+        if not links and nested and all(inner.static for inner, _ in nested):
+            scope.static = True  # a wrapper of static models only (a population's <model><include>): as each is
         scope.attached = frames.attachments(canonical or "")
         for joint_element, joint_path in joints:
             scope.joints.append(self.joint(joint_element, joint_path, frames, scope, version))
