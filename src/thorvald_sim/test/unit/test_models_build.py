@@ -3,6 +3,7 @@ damped, masses and inertias as given, shapes shared by instances, meshes of ever
 teleports, and the spawn time of a small static SDF model."""
 
 import math
+from dataclasses import replace
 
 import pybullet as p
 import pytest
@@ -136,10 +137,27 @@ def test_instances_of_a_mesh_share_one_shape(client, tmp_path):
     cache = ShapeCache(client)
     plants = [SimModel(client, spec, (i, 0.0, 0.0), shapes=cache) for i in range(3)]
     assert len(cache.collision) == 1 and len(cache.visual) == 1
-    assert len({p.getCollisionShapeData(m.body, -1, physicsClientId=client)[0][2] for m in plants}) == 1
+    for i, plant in enumerate(plants):  # each its own static rigid body of the one shape, where it was put
+        assert plant.rigid and p.getBasePositionAndOrientation(plant.body, physicsClientId=client)[0] == (i, 0.0, 0.0)
+        hit = p.rayTest((i, 0.0, 2.0), (i, 0.0, -1.0), physicsClientId=client)[0]
+        assert hit[0] == plant.body
     assert len({p.getNumBodies(physicsClientId=client)}) == 1 and p.getNumBodies(physicsClientId=client) == 3
     with pytest.raises(ModelError):
         SimModel(client + 1, spec, shapes=cache)
+
+
+def test_a_static_rigid_body_collides_where_a_teleport_puts_it(world):
+    """A static model of one link is a static rigid body (bullet updates none of them each step): a
+    teleport moves what collides with it, and a kinematic one (an actor) stays a multibody."""
+    post = SimModel(world, parse_sdf_model(box_sdf("post", (0.2, 0.2, 1.0), static=True), "post"), (0.0, 0.0, 0.5))
+    assert post.rigid
+    post.set_pose((3.0, 1.0, 0.5), (0.0, 0.0, 0.0, 1.0))
+    step(world, 0.1)
+    assert ray_down(world, 3.0, 1.0)[1] == pytest.approx(1.0, abs=1e-6)
+    assert ray_down(world, 0.0, 0.0)[1] == pytest.approx(0.0, abs=1e-6)  # the ground where it was
+    assert post.pose()[0] == pytest.approx((3.0, 1.0, 0.5), abs=1e-9)
+    kinematic = replace(parse_sdf_model(box_sdf("actor", static=True), "actor"), kinematic=True)
+    assert not SimModel(world, kinematic, (5.0, 0.0, 0.5)).rigid
 
 
 @pytest.mark.parametrize("write", [write_obj, write_binary_stl, write_ascii_stl, write_dae])

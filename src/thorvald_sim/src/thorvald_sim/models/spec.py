@@ -173,6 +173,7 @@ class ModelSpec:
     source: str = ""  # where it was read from (messages)
     notes: Tuple[str, ...] = ()  # what was read and left out, each with its element path, said once
     pose: Pose = IDENTITY
+    kinematic: bool = False  # static, but put somewhere new every step (an actor): a body bullet moves
 
     def link(self, name: str) -> LinkSpec:
         for link in self.links:

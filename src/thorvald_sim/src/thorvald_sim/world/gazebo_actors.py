@@ -8,7 +8,7 @@ Pure: no pybullet, no ROS.
 
 import bisect
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import List, Optional, Tuple
 
 from ..models.sdf import parse_sdf_model
@@ -105,7 +105,7 @@ def actor_model(actor: Actor) -> ModelSpec:
         f"<collision name='body'>{shape}</collision><visual name='body'>{shape}"
         "<material><diffuse>0.8 0.5 0.3 1</diffuse></material></visual></link></model></sdf>"
     )
-    return parse_sdf_model(text, f"actor {actor.name}")
+    return replace(parse_sdf_model(text, f"actor {actor.name}"), kinematic=True)
 
 
 # ---------------------------------------------------------------------------------------------
