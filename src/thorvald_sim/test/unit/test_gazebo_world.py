@@ -300,7 +300,7 @@ def test_a_population_of_ten_million_is_refused_fast_in_constant_memory(tmp_path
         tracemalloc.stop()
     message = str(error.value)
     assert f"line {line_of(path, '<population')}: world 'default' > population 'weeds'" in message
-    assert "makes 10000001 bodies" in message and "at most 2000 (Limits.bodies)" in message
+    assert "makes 10000001 bodies" in message and "at most 20000 (Limits.models)" in message
     assert took < 0.5 and peak < 2_000_000  # no list of 10^7 places, nor of 10^7 models
 
 
@@ -319,7 +319,9 @@ def test_a_uniform_population_of_as_many_models_as_observations_is_the_observati
     assert len(places) == 9 and all(close(p[:2], e, 1e-12) and -0.1 <= p[2] <= 0.1 for p, e in zip(places, expected))
 
 
-def test_the_mesh_files_of_every_instance_count_against_the_budget(tmp_path):
+def test_the_mesh_files_count_once_against_the_budget_whatever_the_instances(tmp_path):
+    """Every instance of a mesh shares its shape (thorvald_sim.models.build.ShapeCache): each file
+    counts once, so 4 crops of one mesh take its size, and a second mesh adds its own."""
     models = tmp_path / "models"
     crop = add_model(
         models,
@@ -333,11 +335,11 @@ def test_the_mesh_files_of_every_instance_count_against_the_budget(tmp_path):
         """<population name="crops"><include><uri>model://crop</uri></include><pose>0 0 0 0 0 0</pose>
   <distribution><type>grid</type><rows>2</rows><cols>2</cols><step>1 1 0</step></distribution></population>""",
     )
-    assert len(read_gazebo_world(path, gazebo(models), Limits(mesh_bytes=4 * size)).models) == 4
+    assert len(read_gazebo_world(path, gazebo(models), Limits(mesh_bytes=size)).models) == 4
     with pytest.raises(ConfigError) as error:
-        read_gazebo_world(path, gazebo(models), Limits(mesh_bytes=4 * size - 1))
+        read_gazebo_world(path, gazebo(models), Limits(mesh_bytes=size - 1))
     assert f"line {line_of(path, '<population')}: world 'default' > population 'crops'" in str(error.value)
-    assert f"{4 * size} bytes of mesh files" in str(error.value)
+    assert f"{size} bytes of mesh files" in str(error.value)
 
 
 def test_a_population_gazebo_would_ignore_is_refused_with_why(tmp_path):

@@ -643,7 +643,7 @@ class _Reader:
 
     # ---- the budget of bodies --------------------------------------------------------------------
     def count_bodies(self, world: ET.Element) -> None:
-        """Every model, actor and population instance counted against Limits.bodies (with the ground)
+        """Every model, actor and population instance counted against Limits.models (with the ground)
         before any is read: a population of 10^7 is refused here, at its count."""
         shares: List[Tuple[ET.Element, int]] = []
         for child in world:
@@ -652,7 +652,7 @@ class _Reader:
             elif child.tag == "population":
                 shares.append((child, population_count(child)))
         total = sum(n for _, n in shares) + 1
-        if total <= self.limits.bodies:
+        if total <= self.limits.models:
             return
         self.over_budget = True
         element, largest = max(shares, key=lambda share: share[1])
@@ -660,15 +660,16 @@ class _Reader:
         self.problem(
             element,
             f"makes {total} bodies (models, actors, population instances and the ground{here}); "
-            f"at most {self.limits.bodies} (Limits.bodies)",
+            f"at most {self.limits.models} (Limits.models)",
             largest if element.tag == "population" else None,
         )
 
     def check_mesh_budget(self) -> None:
-        """The mesh files' bytes over every model instance (each loads its files), within Limits.mesh_bytes."""
+        """The mesh files' bytes, each file once (the instances of a mesh share its shape), within
+        Limits.mesh_bytes."""
         shares = []
         sizes: Dict[str, int] = {}
-        for element, spec, instances in self.model_elements:
+        for element, spec, _instances in self.model_elements:
             paths = {
                 shape.geometry.path
                 for link in spec.links
@@ -682,15 +683,15 @@ class _Reader:
                         sizes[path] = os.path.getsize(path)
                     except OSError:
                         sizes[path] = 0
-                total += sizes.get(path, 0)
-            shares.append((element, total * instances))
+                    total += sizes[path]
+            shares.append((element, total))
         total = sum(n for _, n in shares)
         if total > self.limits.mesh_bytes:
             element, largest = max(shares, key=lambda share: share[1])
             self.problem(
                 element,
-                f"its meshes make {total} bytes of mesh files over the world's models ({largest} here: each model "
-                f"loads its files); at most {self.limits.mesh_bytes} (Limits.mesh_bytes)",
+                f"its meshes make {total} bytes of mesh files over the world's models ({largest} first read here); "
+                f"at most {self.limits.mesh_bytes} (Limits.mesh_bytes)",
             )
 
     # ---- models ---------------------------------------------------------------------------------
