@@ -227,3 +227,45 @@ def test_a_robot_on_a_heightmap_hill_stands_on_its_slope_and_climbs_it(tmp_path)
         session.run(6.0, lambda t: (0.5, 0.0, 0.0))
         x1, _, z1, _, _, _ = session.pose()
     assert x1 - x0 > 1.5 and z1 - z0 == pytest.approx(0.1 * (x1 - x0), abs=0.03)
+
+
+PLANT_ROW = """<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="row">
+    <include><uri>model://ground_plane</uri></include>
+    <population name="lettuce">
+      <model name="lettuce"><include><uri>model://crop</uri><static>true</static></include></model>
+      <pose>4 0.375 0 0 0 0</pose>
+      <box><size>2 0.01 0.01</size></box>
+      <distribution><type>linear-x</type></distribution>
+      <model_count>5</model_count>
+    </population>
+  </world>
+</sdf>
+"""
+PRISM_OBJ = (
+    "".join(  # a square prism 0.3 m wide and 0.25 m tall, its base on z = 0
+        f"v {x} {y} {z}\n" for z in (0, 0.25) for x, y in ((-0.15, -0.15), (0.15, -0.15), (0.15, 0.15), (-0.15, 0.15))
+    )
+    + "f 1 2 3\nf 1 3 4\nf 5 7 6\nf 5 8 7\nf 1 5 6\nf 1 6 2\nf 2 6 7\nf 2 7 3\nf 3 7 8\nf 3 8 4\nf 4 8 5\nf 4 5 1\n"
+)
+ROW_LIDAR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "row_lidar.xacro")
+
+
+@pytest.mark.slow  # a robot with a lidar, a fifth of a simulated second
+def test_a_lidar_sees_a_populations_plant_meshes(field, tmp_path):
+    """A row of 5 crops (a population along x through model://, the model's mesh a prism): the
+    lidar's beam straight ahead meets the first plant's near face."""
+    (tmp_path / "models" / "crop" / "meshes" / "crop.obj").write_text(PRISM_OBJ)
+    (tmp_path / "models" / "crop" / "model.sdf").write_text(CROP_SDF.replace("<scale>1 1 2</scale>", ""))
+    (tmp_path / "row.world").write_text(PLANT_ROW)
+    world = load_world(str(tmp_path / "row.world"))
+    places = sorted(m.pose[0][0] for m in world.models)
+    assert len(places) == 5 and places[0] == pytest.approx(3.0)  # Gazebo's linear-x: from the box's -x side
+    options = RunOptions(world=str(tmp_path / "row.world"), model_extras=ROW_LIDAR, record_sensors=True)
+    with RobotSession(STD, options) as session:
+        session.run(0.2, lambda t: None)
+        scan = session.recordings["row_lidar"][-1][1]
+    ahead = scan.ranges[0, scan.ranges.shape[1] // 2]  # 721 beams over 270 degrees: the middle one
+    # the lidar 0.9 m ahead of base_link at y = 0.375, 0.13 m up: the first plant's face at x = 2.85
+    assert ahead == pytest.approx(2.85 - 0.9, abs=0.05)
