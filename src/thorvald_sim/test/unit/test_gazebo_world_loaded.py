@@ -3,8 +3,10 @@ RobotSession): its ground plane our ground, its walls, poles and a crop mesh fro
 built as the Gazebo API's models, what it leaves out said once each; a robot driven in it is stopped
 by the wall it was written with."""
 
+import math
 import os
 
+import numpy as np
 import pytest
 
 from thorvald_sim.tools.runner import RobotSession, RunOptions
@@ -170,8 +172,19 @@ def test_an_actor_walks_its_script_and_the_world_sees_it_there(tmp_path):
     from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
 
     (tmp_path / "crossing.world").write_text(WALKER)
-    with RobotSession(STD, RunOptions(world=str(tmp_path / "crossing.world"))) as session:
+    options = RunOptions(world=str(tmp_path / "crossing.world"), model_extras=ROW_LIDAR, record_sensors=True)
+    with RobotSession(STD, options) as session:
         gazebo = session.engine.gazebo
+
+        def scan():  # the lidar 0.9 m ahead, 0.375 m left of base_link, 0.13 m up (it sees a wheel too)
+            return session.recordings["row_lidar"][-1][1].ranges
+
+        def nearest_new(before):  # the nearest of the returns that are not in the scan before
+            now = scan()
+            seen = np.isfinite(before)
+            new = np.isfinite(now) & ~seen  # where nothing was, or much nearer than what was
+            new[seen] |= np.isfinite(now[seen]) & (now[seen] < before[seen] - 0.1)
+            return float(now[new].min()) if new.any() else None
 
         def beam():  # from beside the robot across the actor's path at x = 0, at chest height
             hit = p.rayTest((0.0, 1.5, 1.2), (0.0, 4.0, 1.2), physicsClientId=session.client)[0]
@@ -182,11 +195,15 @@ def test_an_actor_walks_its_script_and_the_world_sees_it_there(tmp_path):
 
         session.run(0.5, lambda t: None)
         assert x() == pytest.approx(-3.0, abs=1e-9) and beam() is None  # waiting out its delay_start
+        behind = scan()  # the actor behind the lidar's 270 degrees: the robot's own wheel only
         session.run(4.0, lambda t: None)  # 3 s into its 6 s walk: at x = 0
         assert x() == pytest.approx(0.0, abs=0.02)
         assert beam() == pytest.approx(2.5 - 1.5 - 0.25, abs=0.02)  # its near side, 0.25 m before its axis
+        # in the lidar's view: its axis math.hypot(0.9, 2.125) m from the lidar, less its radius
+        assert nearest_new(behind) == pytest.approx(math.hypot(0.9, 2.5 - 0.375) - 0.25, abs=0.05)
         session.run(8.0, lambda t: None)
         assert x() == pytest.approx(3.0, abs=1e-9) and beam() is None  # at the end of its walk, staying
+        assert nearest_new(behind) == pytest.approx(math.hypot(3.0 - 0.9, 2.5 - 0.375) - 0.25, abs=0.05)
 
 
 @pytest.mark.slow  # 8 simulated seconds
@@ -269,3 +286,55 @@ def test_a_lidar_sees_a_populations_plant_meshes(field, tmp_path):
     ahead = scan.ranges[0, scan.ranges.shape[1] // 2]  # 721 beams over 270 degrees: the middle one
     # the lidar 0.9 m ahead of base_link at y = 0.375, 0.13 m up: the first plant's face at x = 2.85
     assert ahead == pytest.approx(2.85 - 0.9, abs=0.05)
+
+
+def polytunnel_world(hoops=12, spacing=2.0, half_width=1.6):
+    """A polytunnel as users' generator scripts write one for Gazebo: a <model> per pole (two a hoop,
+    static cylinders), a hoop above each pair (a static box bent over the aisle, 2.6 m up), and a
+    table along each side (static boxes), every pose written out."""
+    models = []
+    for k in range(hoops):
+        x = k * spacing
+        for side, y in (("l", half_width), ("r", -half_width)):
+            models.append(
+                f"<model name='pole_{k}_{side}'><static>true</static><pose>{x} {y} 1.25 0 0 0</pose><link name='l'>"
+                "<collision name='c'><geometry><cylinder><radius>0.04</radius><length>2.5</length></cylinder>"
+                "</geometry></collision></link></model>"
+            )
+        models.append(
+            f"<model name='hoop_{k}'><static>true</static><pose>{x} 0 2.6 0 0 0</pose><link name='l'><collision "
+            f"name='c'><geometry><box><size>0.05 {2 * half_width} 0.05</size></box></geometry></collision></link>"
+            "</model>"
+        )
+    length = (hoops - 1) * spacing
+    for side, y in (("l", half_width - 0.35), ("r", -half_width + 0.35)):
+        models.append(
+            f"<model name='table_{side}'><static>true</static><pose>{length / 2} {y} 0.8 0 0 0</pose><link name='l'>"
+            f"<collision name='c'><geometry><box><size>{length} 0.5 0.05</size></box></geometry></collision>"
+            "</link></model>"
+        )
+    body = "\n    ".join(models)
+    return f"""<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="tunnel">
+    <include><uri>model://sun</uri></include>
+    <include><uri>model://ground_plane</uri></include>
+    {body}
+  </world>
+</sdf>
+"""
+
+
+@pytest.mark.slow  # a drive of 6 simulated seconds
+def test_a_generated_polytunnel_is_driven_down_its_aisle_and_its_poles_are_where_written(tmp_path):
+    path = tmp_path / "tunnel.world"
+    path.write_text(polytunnel_world())
+    world = load_world(str(path))
+    assert len(world.models) == 12 * 3 + 2 and all(m.static for m in world.models)
+    with RobotSession(STD, RunOptions(world=str(path), x=-2.0)) as session:
+        (pole, _), _, _ = session.engine.gazebo.state("pole_5_r")
+        assert pole == pytest.approx((10.0, -1.6, 1.25), abs=1e-9)
+        session.run(6.0, lambda t: (0.8, 0.0, 0.0))
+        x, y, _, _, _, yaw = session.pose()
+    # down the aisle between the tables (their edges 1 m from the middle), unhindered
+    assert x > 2.0 and abs(y) < 0.05 and abs(yaw) < 0.02, (x, y, yaw)
