@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from thorvald_sim.tools.runner import RobotSession, RunOptions
-from thorvald_sim.world import load_world
+from thorvald_sim.world import load_world, resolve_world
 
 CONFIGS = os.path.join(os.path.dirname(os.path.abspath(__file__)), *[".."] * 3, "thorvald_model", "config")
 STD = os.path.join(CONFIGS, "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
@@ -89,7 +89,24 @@ def test_a_gazebo_world_loads_where_a_world_is_named(field):
     assert "ground_plane" in said and "taken as the ground" in said
     assert "scene" in said  # left out, and said
     assert "sun" not in said  # a light Gazebo's worlds all include: nothing to say
-    assert "physics: Gazebo's steps of 0.001 s, 1000 a second (at 1 x real time), are not taken" in said
+    assert "physics: Gazebo's steps of 0.001 s, 1000 a second: the simulator runs 1 x real time" in said
+    assert world.real_time_factor == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize(("physics", "pace"), [("", 1.0), ("<real_time_update_rate>0</real_time_update_rate>", 0.0),
+    ("<max_step_size>0.004</max_step_size><real_time_update_rate>500</real_time_update_rate>", 2.0)])  # fmt: skip
+def test_a_gazebo_worlds_pace_is_its_steps_a_second_times_their_size(tmp_path, physics, pace):
+    """Gazebo paces its steps at real_time_update_rate a wall second (0: flat out); the simulator takes
+    that pace unless its ~real_time_factor is set (SimulatorParams.paced_by)."""
+    from thorvald_sim.node.params import SimulatorParams  # noqa: PLC0415
+
+    path = tmp_path / "paced.world"
+    path.write_text(f"<sdf version='1.6'><world name='w'><physics type='ode'>{physics}</physics></world></sdf>")
+    world = load_world(str(path))
+    assert world.real_time_factor == pytest.approx(pace)
+    assert SimulatorParams().paced_by(world, given=False).real_time_factor == pytest.approx(pace)
+    assert SimulatorParams(real_time_factor=3.0).paced_by(world, given=True).real_time_factor == 3.0
+    assert SimulatorParams().paced_by(load_world(resolve_world("flat")), given=False) == SimulatorParams()
 
 
 @pytest.mark.slow  # a drive of 6 simulated seconds

@@ -15,7 +15,8 @@ The parameters, their defaults and what each means:
                           per robot)
 ``~physics_rate``         physics steps per simulated second [Hz] (the preset's)
 ``~solver_iterations``    pybullet's solver iterations per step (the preset's)
-``~real_time_factor``     simulated seconds per wall second (1); 0 runs as fast as it can
+``~real_time_factor``     simulated seconds per wall second (1; a Gazebo world's pace when not set); 0
+                          runs as fast as it can
 ``~clock_rate``           /clock messages per simulated second [Hz] (80: every third step at 240 Hz
                           physics; at most one a step)
 ``~odometry_rate``        odometry/gazebo and joint_states per simulated second [Hz] (50)
@@ -55,7 +56,7 @@ Pure: no rospy.
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Callable, Tuple
 
 from ..errors import ParameterError
@@ -89,6 +90,13 @@ class SimulatorParams:
     worker_strips: Tuple[float, ...] = ()  # [m] N - 1 increasing x: worker k takes spawn x in its strip
     gazebo_namespace: str = "/gazebo"  # where Gazebo's ROS API is offered (thorvald_sim.gazebo.api)
     gazebo_states_rate: float = 50.0  # [Hz] of model_states and link_states; 0: every physics step
+
+    def paced_by(self, world, given: bool) -> "SimulatorParams":
+        """These parameters with a Gazebo world's pace (``WorldConfig.real_time_factor``: its physics'
+        steps a second times their size) as the real-time factor, unless ``~real_time_factor`` was given."""
+        if world.real_time_factor is None or given:
+            return self
+        return replace(self, real_time_factor=world.real_time_factor)
 
     @classmethod
     def read(cls, get: Getter) -> "SimulatorParams":

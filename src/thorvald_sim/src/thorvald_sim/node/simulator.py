@@ -55,15 +55,16 @@ EXIT_REFUSED = 1
 
 class SimulatorNode:
     def __init__(self):
-        self.params = params = SimulatorParams.read(lambda name, default: rospy.get_param("~" + name, default))
+        params = SimulatorParams.read(lambda name, default: rospy.get_param("~" + name, default))
         world = load_world(resolve_world(params.world))
+        self.params = params = params.paced_by(world, rospy.has_param("~real_time_factor"))  # a Gazebo world's pace
         self.gui = params.gui
         self.real_time_factor = params.real_time_factor
         self.command_timeout = params.command_timeout
         self.max_lag = params.max_lag
         self.default_tf = params.publish_tf
         self.paused = params.paused
-        datum = load_datum(params.datum_file) if params.datum_file else world.datum  # a Gazebo world's own
+        datum = load_datum(params.datum_file) if params.datum_file else world.datum
         self.lockstep = params.lockstep
         self.waits = Lockstep()  # lockstep: which robots the world waits for, for which instant
         self.pacer = Pacer(params.real_time_factor)
@@ -97,16 +98,9 @@ class SimulatorNode:
             self.gazebo.add_world_models(world)  # a Gazebo world file's models, as Gazebo loads them
             self.services = SimulatorServices(self)
         self.publish_clock()
-        rospy.loginfo(
-            "simulator: world %s (%s), physics %s: %g Hz, %d solver iterations, real-time factor %s%s",
-            params.world,
-            world.source,
-            params.physics,
-            params.physics_rate,
-            params.solver_iterations,
-            self.real_time_factor or "as fast as possible",
-            ", paused" if self.paused else "",
-        )
+        rospy.loginfo("simulator: world %s (%s), physics %s: %g Hz, %d solver iterations, real-time factor %s%s",
+                      params.world, world.source, params.physics, params.physics_rate, params.solver_iterations,
+                      self.real_time_factor or "as fast as possible", ", paused" if self.paused else "")  # fmt: skip
         if self.sim.pids:
             rospy.loginfo(
                 "simulator: %d physics workers, pids %s, %s",

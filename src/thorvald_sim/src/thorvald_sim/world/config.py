@@ -34,6 +34,7 @@ class WorldConfig:
     actors: Tuple[Any, ...] = ()
     datum: Any = None
     notes: Tuple[str, ...] = ()
+    real_time_factor: Optional[float] = None  # a Gazebo world's pace (its physics' steps a second x step); 0: flat out
 
     def __getattr__(self, name: str) -> Any:
         # called for a name that is no field or method only: a kind's section; read from __dict__, as
