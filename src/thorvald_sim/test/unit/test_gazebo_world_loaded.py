@@ -355,3 +355,37 @@ def test_a_generated_polytunnel_is_driven_down_its_aisle_and_its_poles_are_where
         x, y, _, _, _, yaw = session.pose()
     # down the aisle between the tables (their edges 1 m from the middle), unhindered
     assert x > 2.0 and abs(y) < 0.05 and abs(yaw) < 0.02, (x, y, yaw)
+
+
+GNSS_EXTRAS = """<?xml version="1.0"?>
+<robot xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:include filename="$(find thorvald_model)/urdf/sensor_modules/sensor_modules.xacro"/>
+  <xacro:gnss_antenna parent="${tf_prefix}base_link" name="gnss" xyz="0 0 1.2" noise="0 0 0" velocity_noise="0 0 0"/>
+</robot>
+"""
+
+
+@pytest.mark.slow  # a robot with a GNSS, 4 simulated seconds
+def test_a_gazebo_worlds_spherical_coordinates_are_the_gnss_datum(tmp_path):
+    """<spherical_coordinates> at 52 N 1 W: the antenna over the origin reads them; driving along the
+    world's x axis goes west, as Gazebo 11's frame has it with a heading of 0 (its x axis at ENU 180 deg)."""
+    (tmp_path / "gnss.xacro").write_text(GNSS_EXTRAS)
+    (tmp_path / "geo.world").write_text(
+        "<sdf version='1.6'><world name='w'><include><uri>model://ground_plane</uri></include>"
+        "<spherical_coordinates><surface_model>EARTH_WGS84</surface_model><latitude_deg>52</latitude_deg>"
+        "<longitude_deg>-1</longitude_deg><elevation>50</elevation><heading_deg>0</heading_deg>"
+        "</spherical_coordinates></world></sdf>"
+    )
+    extras = str(tmp_path / "gnss.xacro")
+    options = RunOptions(world=str(tmp_path / "geo.world"), model_extras=extras, record_sensors=True)
+    with RobotSession(STD, options) as session:
+        session.run(0.5, lambda t: None)
+        start = session.recordings["gnss_plugin"][-1][1]
+        session.run(4.5, lambda t: (0.5, 0.0, 0.0))
+        moved = session.pose()[0]
+        end = session.recordings["gnss_plugin"][-1][1]
+    assert start.latitude == pytest.approx(52.0, abs=1e-7) and start.longitude == pytest.approx(-1.0, abs=1e-7)
+    assert moved > 1.0
+    assert end.latitude == pytest.approx(52.0, abs=1e-6)  # due west: the latitude stays
+    metres_per_degree = 6378137.0 * math.cos(math.radians(52.0)) * math.pi / 180  # WGS84, east at 52 N, about
+    assert (end.longitude - start.longitude) * metres_per_degree == pytest.approx(-moved, rel=0.01)

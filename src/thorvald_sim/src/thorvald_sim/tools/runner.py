@@ -276,7 +276,9 @@ class RobotSession:
         self.world = world if world is not None else load_world(resolve_world(options.world))
         # its world made as the simulator node makes its own (thorvald_sim.physics.engine): a DIRECT client
         rate, iterations = physics.rate, physics.solver_iterations
-        settings = WorldSettings(self.world, rate, seed=options.seed, solver_iterations=iterations)
+        # a Gazebo world's <spherical_coordinates> are its GNSS datum, as in the simulator node
+        datum = self.world.datum
+        settings = WorldSettings(self.world, rate, seed=options.seed, datum=datum, solver_iterations=iterations)
         self.engine = Engine(settings)
         self.client = self.engine.client
         self.sim = self.engine.sim
