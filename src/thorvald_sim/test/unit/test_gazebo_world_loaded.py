@@ -389,3 +389,33 @@ def test_a_gazebo_worlds_spherical_coordinates_are_the_gnss_datum(tmp_path):
     assert end.latitude == pytest.approx(52.0, abs=1e-6)  # due west: the latitude stays
     metres_per_degree = 6378137.0 * math.cos(math.radians(52.0)) * math.pi / 180  # WGS84, east at 52 N, about
     assert (end.longitude - start.longitude) * metres_per_degree == pytest.approx(-moved, rel=0.01)
+
+
+CAMERA_EXTRAS = """<?xml version="1.0"?>
+<robot xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:include filename="$(find thorvald_model)/urdf/sensor_modules/sensor_modules.xacro"/>
+  <xacro:rgbd_camera parent="${tf_prefix}base_link" name="front" xyz="1.0 0 0.8" width="64" height="48"/>
+</robot>
+"""
+
+
+@pytest.mark.slow  # a robot with a camera, rendered in software
+def test_a_camera_sees_a_world_models_material_colour(tmp_path):
+    """A wall of the world file's own colour (<material><diffuse>) 3 m ahead fills the middle of the
+    robot's camera image with it (lit: pybullet's renderer shades it, the hue stays)."""
+    (tmp_path / "camera.xacro").write_text(CAMERA_EXTRAS)
+    (tmp_path / "wall.world").write_text(
+        "<sdf version='1.6'><world name='w'><include><uri>model://ground_plane</uri></include>"
+        "<model name='wall'><static>true</static><pose>4 0 1 0 0 0</pose><link name='l'>"
+        "<collision name='c'><geometry><box><size>0.2 8 2</size></box></geometry></collision>"
+        "<visual name='v'><geometry><box><size>0.2 8 2</size></box></geometry>"
+        "<material><diffuse>0.1 0.3 0.9 1</diffuse></material></visual></link></model></world></sdf>"
+    )
+    extras = str(tmp_path / "camera.xacro")
+    options = RunOptions(world=str(tmp_path / "wall.world"), model_extras=extras, record_sensors=True)
+    with RobotSession(STD, options) as session:
+        session.run(0.3, lambda t: None)
+        (name,) = [n for n in session.recordings if session.recordings[n]]
+        image = session.recordings[name][-1][1].image
+    r, g, b = (float(v) for v in image[20:28, 28:36, :3].reshape(-1, 3).mean(axis=0))
+    assert b > 1.5 * g > 1.5 * 1.5 * r, (r, g, b)  # the wall's blue, its green a third, its red a ninth
