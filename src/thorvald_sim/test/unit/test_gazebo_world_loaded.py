@@ -419,3 +419,20 @@ def test_a_camera_sees_a_world_models_material_colour(tmp_path):
         image = session.recordings[name][-1][1].image
     r, g, b = (float(v) for v in image[20:28, 28:36, :3].reshape(-1, 3).mean(axis=0))
     assert b > 1.5 * g > 1.5 * 1.5 * r, (r, g, b)  # the wall's blue, its green a third, its red a ninth
+
+
+def test_a_16_bit_heightmap_is_read_whole_as_gazebo_sim_reads_it(tmp_path):
+    """A 16-bit image (Gazebo Classic reads only each pixel's low byte): every level, the brightest
+    pixel at size z, and said."""
+    import numpy as np  # noqa: PLC0415
+    from PIL import Image  # noqa: PLC0415
+
+    levels = np.zeros((5, 5), dtype=np.uint16)
+    levels[0, 0] = 65535  # the (-x, +y) corner
+    levels[4, 4] = 300  # the (+x, -y) corner: 300 / 65535 of the way up (a low byte of 44 in Classic)
+    Image.fromarray(levels).save(str(tmp_path / "hill.png"))
+    (tmp_path / "hill.world").write_text(HILL)
+    world = load_world(str(tmp_path / "hill.world"))
+    assert world.ground_height(-4.0, 4.0) == pytest.approx(2.0, abs=1e-6)
+    assert world.ground_height(4.0, -4.0) == pytest.approx(300 / 65535 * 2.0, abs=1e-6)
+    assert any("16-bit image: read whole" in note for note in world.notes)

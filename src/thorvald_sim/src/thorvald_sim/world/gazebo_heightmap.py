@@ -116,6 +116,7 @@ class HeightFieldKeys(NamedTuple):
 
     keywords: Dict[str, Any]
     differences: Tuple[str, ...]
+    kind: str = "grey"  # of the image, as read: "grey", "palette", "colour" or "16-bit"
 
 
 class _Read(NamedTuple):
@@ -267,7 +268,7 @@ def as_height_field(
         "rut_spacing": 1.5,
         "flat_radius": 0.0,
     }
-    return HeightFieldKeys(keywords, tuple(differences))
+    return HeightFieldKeys(keywords, tuple(differences), read.kind)
 
 
 # ---------------------------------------------------------------------------------------------

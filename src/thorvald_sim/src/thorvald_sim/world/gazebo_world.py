@@ -941,7 +941,12 @@ class _Reader:
             check_image_budget(found, self.limits)
             width, height = image_size(found)
             points = ((max(width, height) - 1) * used + 1) ** 2  # Gazebo's grid: our field's is the pixels
-            keys = as_height_field(found, size, pos, sampling, max_points=max(points, 4))
+            # a 16-bit image whole, its brightest pixel at size z, as Gazebo Sim reads it: Gazebo Classic 11
+            # reads each pixel's low byte (gazebo_heightmap's item 4), so no Classic world relied on one
+            keys = as_height_field(found, size, pos, sampling, sixteen_bit="full", max_points=max(points, 4))
+            if keys.kind == "16-bit":
+                self.note(shape, "a 16-bit image: read whole, its brightest pixel at size z, as Gazebo Sim reads it "
+                          "(Gazebo Classic 11 reads each pixel's low byte)")  # fmt: skip
         except ValueError as e:
             self.problem(shape, f"{uri} ({found}) {e}", uri)
             return
