@@ -399,6 +399,9 @@ def test_link_cut_stops_the_wheels_and_restoring_it_gives_control_back(fleet, si
     fleet.wait_sim(0.3)
     t_cut, seq_cut = fleet.now(), fleet.seq(robot)
     fleet.net.set_link(key, up=False)
+    # the link went down between t_cut and t_down (setting it down is a process of its own, which a
+    # loaded machine may start late: 0.9 s of simulated time was seen once)
+    t_down = fleet.now()
     try:
         fleet.wait(lambda: fleet.still(robot), f"{robot} to stop with the link cut")
         fleet.wait_sim(HOLD)
@@ -456,8 +459,9 @@ def test_link_cut_stops_the_wheels_and_restoring_it_gives_control_back(fleet, si
     fleet.figures[f"{side}-side cut: operator's odometry ends after the cut [s sim]"] = round(
         operator_odom[1] - t_cut, 3
     )
-    assert operator_odom[1] < t_cut + 0.3, (
-        f"the operator received odometry stamped {operator_odom[1] - t_cut:.2f} s after the link was cut"
+    assert operator_odom[1] < t_down + 0.3, (
+        f"the operator received odometry stamped {operator_odom[1] - t_down:.2f} s after the link was down "
+        f"({operator_odom[1] - t_cut:.2f} s after it was cut)"
     )
 
     # the link is back: a new command (backwards) drives the robot again
