@@ -69,11 +69,9 @@ from gazebo_msgs.srv import (
 )
 from thorvald_base.publishing import NonBlockingPublisher
 from thorvald_base.rate_grid import RateGrid
-from thorvald_model.errors import ConfigError, Problem
 
 from ..errors import SpawnError, WorkerError
 from ..physics.robot import Pose2D
-from ..world.rules import WHAT
 from . import frames
 from .bodies import MODEL_FRAME, STATES_LINKS, STATES_MODELS, Job
 from .entities import GROUND, GROUND_KIND, MODEL, ROBOT, WORLD, Entities, Entity, Joint, Link, Model
@@ -293,32 +291,26 @@ class GazeboApi:
         """The models of a Gazebo world file (WorldConfig.models), each built as :meth:`add_spec` builds a
         spawned one, so that the API lists and moves them as Gazebo does; what was left out of the file
         said once each. ConfigError naming the world file and the model a world cannot take."""
+        from ..world.gazebo_world import world_bodies  # noqa: PLC0415  (a Gazebo world's only)
+
         for note in world.notes:
             rospy.logwarn("simulator: %s: %s", os.path.basename(world.source), note)
-        from ..world.gazebo_actors import actor_model  # noqa: PLC0415  (a Gazebo world's only)
-
-        for model in world.models:
+        for body in world_bodies(world):  # an actor: a static model in every world, moved by its script in each
             try:
-                self.add_spec(model.name, replace(model.spec, static=model.static), model.pose)
+                self.add_spec(body.name, body.spec, body.pose)
             except SpawnError as e:
-                problem = Problem(f"model '{model.name}'", model.spec.source, f"is built here: {e}")
-                raise ConfigError(world.source, [problem], WHAT) from None
-        for actor in world.actors:  # a static model in every world, moved by its script in each
-            try:
-                self.add_spec(actor.name, actor_model(actor), actor.pose_at(0.0))
-            except SpawnError as e:
-                problem = Problem(f"actor '{actor.name}'", world.source, f"is built here: {e}")
-                raise ConfigError(world.source, [problem], WHAT) from None
-            for worker in self.entities.model(actor.name).workers:
-                self.node.sim.ask(worker, ("animate", actor.name, actor))
+                raise body.refused(world.source, str(e)) from None
+            if body.actor is not None:
+                for worker in self.entities.model(body.name).workers:
+                    self.node.sim.ask(worker, ("animate", body.name, body.actor))
 
     def model_path(self):
         """Gazebo's model path as this process's environment and the ROS packages' exports give it
         (:class:`~thorvald_sim.models.gazebo_paths.GazeboPaths`), read at the first spawn."""
         if self._paths is None:
-            from ..models.gazebo_paths import GazeboPaths  # noqa: PLC0415  (rospkg: only when a model comes)
+            from ..models.gazebo_paths import gazebo_paths  # noqa: PLC0415  (rospkg: only when a model comes)
 
-            self._paths = GazeboPaths()
+            self._paths = gazebo_paths()
         return self._paths
 
     def remove_model(self, model: Model) -> None:

@@ -39,6 +39,7 @@ directory) are not searched; a missing absolute path is not looked for again und
 Pure: no pybullet, no ROS (rospkg is imported only to read the packages, when no reader is given).
 """
 
+import functools
 import os
 import re
 import xml.etree.ElementTree as ET
@@ -157,18 +158,6 @@ def ros_package_exports() -> List[PackageExport]:
     return found
 
 
-def ros_package_folder(package: str) -> Optional[str]:
-    """The folder of a ROS package (rospkg), None when it is not installed."""
-    try:
-        import rospkg  # noqa: PLC0415  (only when a package:// file is named)
-    except ImportError:
-        return None
-    try:
-        return rospkg.RosPack().get_path(package)
-    except rospkg.ResourceNotFound:
-        return None
-
-
 def included_kind(sdf_text: str) -> Optional[str]:
     """What an ``<include>`` of this SDF text adds, as sdformat 9 reads it: ``"model"``, ``"actor"`` or
     ``"light"`` (the built-in sun), None when it has none of them (or is not XML)."""
@@ -242,10 +231,12 @@ class GazeboPaths:
         """environ: the environment (default os.environ, read now); exports: the packages' exports to
         gazebo_ros (default :func:`ros_package_exports`); gazebo_share: Gazebo's installed share folder,
         used when it is a folder (None: no Gazebo); package_folder: a ROS package's folder, for
-        package:// (default :func:`ros_package_folder`)."""
+        package:// (default :func:`thorvald_sim.physics.description.installed_package_path`)."""
         env = dict(os.environ if environ is None else environ)
         self.problems: List[str] = []
-        self._package_folder = package_folder or ros_package_folder
+        if package_folder is None:
+            from ..physics.description import installed_package_path as package_folder  # noqa: PLC0415
+        self._package_folder = package_folder
         models: List[Folder] = []
         resources: List[Folder] = []
         home = env.get("HOME")
@@ -446,6 +437,22 @@ class GazeboPaths:
         if found is not None:
             return found, ""
         return None, self._not_found(f"world {name}", self.resource_folders, "resource")
+
+
+# the environment variables a GazeboPaths reads (rospkg reads ROS_PACKAGE_PATH for the exports)
+ENVIRONMENT = ("HOME", "GAZEBO_MODEL_PATH", "GAZEBO_RESOURCE_PATH", "ROS_PACKAGE_PATH")
+
+
+def gazebo_paths() -> GazeboPaths:
+    """This process's Gazebo paths (its environment and the ROS packages' exports), read once for as
+    long as the environment stays the same: the world's loader, its name's lookup and the Gazebo API
+    share them (reading the packages' exports costs about 0.3 s)."""
+    return _paths_for(tuple(os.environ.get(name) for name in ENVIRONMENT))
+
+
+@functools.lru_cache(maxsize=4)
+def _paths_for(_environment: Tuple[Optional[str], ...]) -> GazeboPaths:
+    return GazeboPaths()
 
 
 def _unique(folders: Sequence[Folder]) -> Tuple[Folder, ...]:

@@ -107,25 +107,17 @@ def default_finder(base_dir: Optional[str] = None, model: Optional[MeshFinder] =
             return model(uri)
         if "://" in uri or os.path.isabs(uri) or base_dir is None:
             if not packages:
-                from ..physics.description import mesh_finder  # noqa: PLC0415  (thorvald_model: only once a mesh is named)
+                from ..physics.description import (  # noqa: PLC0415  (thorvald_model: only once a mesh is named)
+                    installed_package_path,
+                    mesh_finder,
+                )
 
-                packages.append(mesh_finder(_package_path))
+                packages.append(mesh_finder(installed_package_path))
             return packages[0](uri)
         path = os.path.join(base_dir, uri)
         return (path, "") if os.path.isfile(path) else (None, f"no such file in {base_dir}")
 
     return find
-
-
-def _package_path(package: str) -> Optional[str]:
-    try:
-        import rospkg  # noqa: PLC0415  (only when a package:// mesh is named)
-    except ImportError:
-        return None
-    try:
-        return rospkg.RosPack().get_path(package)
-    except rospkg.ResourceNotFound:
-        return None
 
 
 def parse_sdf_model(

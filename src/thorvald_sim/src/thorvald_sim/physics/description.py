@@ -439,6 +439,19 @@ def resolve_meshes_of(root: ET.Element, find: MeshFinder) -> Tuple[MissingMesh, 
     return tuple(missing)
 
 
+def installed_package_path(package: str) -> Optional[str]:
+    """The folder of a ROS package found through rospack (ROS_PACKAGE_PATH), None if it is not there
+    (or rospkg is not installed)."""
+    try:
+        import rospkg  # noqa: PLC0415  (rospkg is not the ROS runtime; only needed when a package:// file is named)
+    except ImportError:
+        return None
+    try:
+        return rospkg.RosPack().get_path(package)
+    except rospkg.ResourceNotFound:
+        return None
+
+
 def mesh_finder(package_path: Callable[[str], Optional[str]]) -> MeshFinder:
     """A MeshFinder for ``package://PKG/...`` (package_path(PKG): its folder, None if not installed),
     ``file://...`` and plain absolute paths; anything else (a relative path, Gazebo's ``model://``)

@@ -18,22 +18,12 @@ from ..sensors.blocks import Datum
 from ..sensors.mounted import build_sensors, disabled_report, sensor_report
 from ..world import WorldConfig
 from .as_built import SimAsBuilt
-from .description import DescriptionError, MeshFinder, mesh_finder, spawned_description
+from .description import DescriptionError, MeshFinder, installed_package_path, mesh_finder, spawned_description
 from .presets import PRESETS
 from .robot import TYRE_CONTACT_WIDTH, Pose2D, SimRobot
 from .scene import build_scene
 
 SOLVER_ITERATIONS = PRESETS["default"].solver_iterations  # pybullet's default, set explicitly
-
-
-def installed_package_path(package: str) -> Optional[str]:
-    """The folder of a ROS package found through rospack (ROS_PACKAGE_PATH), None if it is not there."""
-    import rospkg  # noqa: PLC0415  (rospkg is not the ROS runtime; only needed when a description has meshes)
-
-    try:
-        return rospkg.RosPack().get_path(package)
-    except rospkg.ResourceNotFound:
-        return None
 
 
 @dataclass(frozen=True)

@@ -33,7 +33,6 @@ Not pure: it runs pybullet (a DIRECT client of its own, closed at the end). No R
 """
 
 import csv
-import dataclasses
 import json
 import math
 import os
@@ -61,8 +60,7 @@ from ..physics.engine import Engine, WorldSettings
 from ..physics.presets import physics_settings
 from ..physics.robot import Pose2D, Vec3
 from ..world import WorldConfig, load_world, resolve_world
-from ..world.gazebo_actors import actor_model
-from ..world.rules import WHAT as WORLD_WHAT
+from ..world.gazebo_world import world_bodies
 
 WHAT = "list of commands"
 ONCE = ("directions",)  # a lidar's beams in its frame: the same every reading
@@ -283,18 +281,12 @@ class RobotSession:
         self.client = self.engine.client
         self.sim = self.engine.sim
         try:
-            for model in self.world.models:  # a Gazebo world file's, built as the simulator node builds them
-                spec = dataclasses.replace(model.spec, name=model.name, static=model.static)
-                built = self.engine.gazebo.spawn_model(model.name, spec, model.pose)
+            for body in world_bodies(self.world):  # a Gazebo world's, built as the simulator node builds them
+                built = self.engine.gazebo.spawn_model(body.name, body.spec, body.pose)
                 if isinstance(built, str):
-                    problem = Problem(f"model '{model.name}'", model.spec.source, f"is built here: {built}")
-                    raise ConfigError(self.world.source, [problem], WORLD_WHAT)
-            for actor in self.world.actors:  # moved by their scripts, as in the simulator node
-                built = self.engine.gazebo.spawn_model(actor.name, actor_model(actor), actor.pose_at(0.0))
-                if isinstance(built, str):
-                    problem = Problem(f"actor '{actor.name}'", self.world.source, f"is built here: {built}")
-                    raise ConfigError(self.world.source, [problem], WORLD_WHAT)
-                self.engine.gazebo.animate(actor.name, actor)
+                    raise body.refused(self.world.source, built)
+                if body.actor is not None:  # moved by its script
+                    self.engine.gazebo.animate(body.name, body.actor)
             pose = Pose2D(options.x, options.y, options.z, options.yaw, options.roll, options.pitch)
             self.robot = self.sim.spawn(options.robot_name, urdf, pose, as_built)
             calculator = load_calculator(config, estimator=driver.estimator, projection=driver.projection)

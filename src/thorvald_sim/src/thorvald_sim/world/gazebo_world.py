@@ -115,7 +115,7 @@ import random
 import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, replace
-from typing import Any, Dict, List, Optional, Sequence, Set, Tuple
+from typing import Any, Dict, Iterator, List, Optional, Sequence, Set, Tuple
 from xml.parsers import expat
 
 from thorvald_model.datum import Datum
@@ -123,12 +123,13 @@ from thorvald_model.errors import MISSING, ConfigError, Problem
 
 from ..errors import ModelError
 from ..models import reading
-from ..models.gazebo_paths import GazeboPaths, included_kind
+from ..models.gazebo_paths import GazeboPaths, gazebo_paths, included_kind
 from ..models.sdf import LATEST, parse_sdf_model
 from ..models.spec import IDENTITY, Mesh, ModelSpec, Pose, Vec3, compose, pose_from_xyz_rpy, tree
-from .gazebo_actors import Actor, Trajectory, trajectory
+from .gazebo_actors import Actor, Trajectory, actor_model, trajectory
 from .gazebo_population import POPULATION_TYPES, population_count, population_places
 from .limits import LIMITS, Limits
+from .rules import WHAT as WORLD
 from .terrain import check_image_budget, image_size
 
 WHAT = "Gazebo world"
@@ -208,6 +209,35 @@ class WorldModel:
 
 
 @dataclass(frozen=True)
+class WorldBody:
+    """A model to build of a loaded Gazebo world (:func:`world_bodies`): its spec ready to build (named,
+    the ``<include>`` 's static applied; an actor's cylinder), its pose in the world, and for an actor the
+    script that moves it."""
+
+    name: str
+    spec: ModelSpec
+    pose: Pose
+    what: str  # "model" or "actor", as a refusal names it
+    source: str  # where it was read from, as a refusal gives it
+    actor: Optional[Actor] = None
+
+    def refused(self, world_source: str, why: str) -> ConfigError:
+        """The error of a world whose body this is, which the physics would not build (why)."""
+        problem = Problem(f"{self.what} '{self.name}'", self.source, f"is built here: {why}")
+        return ConfigError(world_source, [problem], WORLD)
+
+
+def world_bodies(world) -> Iterator[WorldBody]:
+    """The models, then the actors, of a Gazebo world loaded as ours (WorldConfig.models and .actors),
+    as the simulator node and run_robot build them."""
+    for model in world.models:
+        spec = replace(model.spec, name=model.name, static=model.static)
+        yield WorldBody(model.name, spec, model.pose, "model", model.spec.source)
+    for actor in world.actors:
+        yield WorldBody(actor.name, actor_model(actor), actor.pose_at(0.0), "actor", world.source, actor)
+
+
+@dataclass(frozen=True)
 class GazeboWorld:
     """A Gazebo world file, read (:func:`read_gazebo_world`)."""
 
@@ -262,7 +292,7 @@ def read_gazebo_world(
     paths: Gazebo's model and resource folders (default: this environment's); limits: the budgets;
     seed: of the random populations' places. ConfigError naming every problem, each with its line.
     """
-    return _Reader(path, paths if paths is not None else GazeboPaths(), limits, seed).read()
+    return _Reader(path, paths if paths is not None else gazebo_paths(), limits, seed).read()
 
 
 # ---------------------------------------------------------------------------------------------

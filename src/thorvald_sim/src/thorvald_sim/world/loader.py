@@ -227,9 +227,9 @@ def resolve_world(name_or_path: str) -> str:
     if os.path.exists(name_or_path):
         return name_or_path
     if name_or_path.endswith((".world", ".sdf")):  # a Gazebo world's name: on Gazebo's resource path
-        from ..models.gazebo_paths import GazeboPaths  # noqa: PLC0415  (rospkg: only for such a name)
+        from ..models.gazebo_paths import gazebo_paths  # noqa: PLC0415  (rospkg: only for such a name)
 
-        found, why = GazeboPaths().find_world(name_or_path)
+        found, why = gazebo_paths().find_world(name_or_path)
         if found is None:
             raise ConfigError(name_or_path, [Problem("", MISSING, why)], WHAT)
         return found
