@@ -30,9 +30,11 @@ Figures per case, over ``--seconds`` simulated seconds after 5 s of warm-up:
   processes' CPU less the solver), base_driver, twist_mux (or the fleet_driver holding both),
   robot_state_publisher, the ROS master, the rest (the world -> odom publishers); and the whole
   stack's against the solver's;
-- raw pybullet beside it: the same number of standard robots stepped by pybullet alone in this
-  process (the simulator's Simulation class builds the world, then bare stepSimulation at the
-  preset's rate, 10 simulated seconds), and the simulator's CPU (node, workers, solver) against it.
+- raw pybullet beside it: the same number of standard robots on the same circles stepped by
+  pybullet alone in this process (the simulator's Simulation class builds the world, then bare
+  stepSimulation at the preset's rate, 10 simulated seconds), back to back and, at real time, at the
+  node's pace (``raw_pybullet``); the simulator's CPU (node, workers, solver) and its solver against
+  them (target: the solver at most 1.3 times the same steps raw).
 
 A projection per stack: the fleet a machine of 8 and 16 cores would hold at real time, from the
 largest fleet measured without lidars. Its assumptions: the CPU per robot of each part stays what
@@ -86,6 +88,7 @@ TARGET_FLEET = 20
 TARGET_LIDAR_FLEET = 12
 TARGET_SIMULATOR = 1.3
 TARGET_WORKER_FLEET = 24  # with physics workers (issue 35)
+TARGET_SOLVER_RAW = 1.3  # the solver inside the node against the same steps raw
 PROJECTED_CORES = (8, 16)
 CORE_USE = 0.9  # of a core a process, and of the machine the whole stack, in the projection
 RAW_SECONDS = 10.0  # [s] simulated of raw pybullet per fleet size
@@ -155,10 +158,29 @@ def cpu_by_role(roles):
     return totals
 
 
-def raw_pybullet(n: int, physics: str, seconds: float = RAW_SECONDS) -> float:
-    """CPU [s] per robot and simulated second of bare pybullet stepping n standard robots (6 m apart,
-    commanded 0.3 m/s) at the preset's rate and iterations, in this process: the world built by the
-    simulator's Simulation class."""
+def raw_pybullet(
+    n: int, physics: str, seconds: float = RAW_SECONDS, straight: bool = False, paced: bool = False
+) -> float:
+    """CPU [s] per robot and simulated second of bare pybullet stepping n standard robots (6 m apart)
+    at the preset's rate and iterations, in this process: the world built by the simulator's
+    Simulation class, each robot driving the circle the fleet's robot k drives (``twist_of``), its
+    drives commanded as its base_driver commands them (the robot's own calculator).
+
+    The same manoeuvre matters: a turning robot's wheels keep up to four contact points each in
+    pybullet's contact manifolds (the points a wheel rolled over while it turned stay within
+    pybullet's breaking distance), where a robot driving straight keeps one, and the solver's 50
+    iterations run to the end instead of stopping early: the same robots on circles cost two to three
+    times what they cost driving straight (straight=True measures that reference).
+
+    paced: each step taken at its wall time at real time, as the node at real_time_factor 1 takes
+    them, the thread sleeping in between; else back to back. The CPU is the thread's around each
+    stepSimulation, as the node's solver figure is. A step after a pause costs more than one right
+    after another (on this machine, in one process without ROS: 16 robots at the fleet preset 1.04
+    times after pauses of 0.2 ms, 1.2 after 1 ms, 1.5 after 5 ms; busy-waiting the 5 ms instead of
+    sleeping, 1.35), so the node at real time is compared with both."""
+    from thorvald_base.kinematics.types import Twist  # noqa: PLC0415
+    from thorvald_base.plugins import load_calculator  # noqa: PLC0415
+    from thorvald_model import load_robot_config  # noqa: PLC0415
     from thorvald_model.description import generate_urdf  # noqa: PLC0415
     from thorvald_sim.bullet import pybullet as p  # noqa: PLC0415
     from thorvald_sim.physics.presets import physics_settings  # noqa: PLC0415
@@ -168,19 +190,27 @@ def raw_pybullet(n: int, physics: str, seconds: float = RAW_SECONDS) -> float:
 
     settings = physics_settings(physics, None, None)
     urdf = generate_urdf(STD)
+    calculator = load_calculator(load_robot_config(STD))
     client = p.connect(p.DIRECT)
     try:
         sim = Simulation(
             client, load_world(resolve_world("flat")), settings.rate, solver_iterations=settings.solver_iterations
         )
         for k in range(n):
-            sim.spawn(f"r{k}", urdf, Pose2D(*grid(k, n), 0.0)).command([0.0] * 4, [0.3] * 4)
-        for _ in range(round(settings.rate)):  # under way
+            vx, wz = twist_of(k) if not straight else (0.3, 0.0)
+            drives = calculator.calculate_command(Twist(vx, 0.0, wz)).commands
+            robot = sim.spawn(f"r{k}", urdf, Pose2D(*grid(k, n), 0.0))
+            robot.command([d.steering for d in drives], [d.speed for d in drives])
+        for _ in range(round(2 * settings.rate)):  # under way, the steering turned
             sim.step()
-        cpu = time.process_time()
-        for _ in range(round(seconds * settings.rate)):
+        cpu, start, steps = 0.0, time.perf_counter(), round(seconds * settings.rate)
+        for k in range(steps):
+            if paced:
+                time.sleep(max(0.0, start + k / settings.rate - time.perf_counter()))
+            t = time.thread_time()
             p.stepSimulation(physicsClientId=client)
-        return (time.process_time() - cpu) / seconds / n
+            cpu += time.thread_time() - t
+        return cpu / seconds / n
     finally:
         p.disconnect(client)
 
@@ -309,7 +339,11 @@ def simulator_cpu(r) -> float:
 def print_row(n, lidar, stack, r):
     ms = {role: 1000 * r.get(role, 0.0) for role in ROLES}
     total = sum(ms.values())
-    raw = f" {1000 * r['raw']:>7.1f} {simulator_cpu(r) / r['raw']:>7.2f}x" if "raw" in r else ""
+    raw = ""
+    if "raw" in r:  # the same robots on the same circles, stepped raw: the simulator's and its solver's against it
+        raw = f" {1000 * r['raw']:>7.1f} {simulator_cpu(r) / r['raw']:>7.2f}x {r['solver'] / r['raw']:>7.2f}x"
+        if "raw_paced" in r:  # raw at the node's pace
+            raw += f" {1000 * r['raw_paced']:>7.1f} {r['solver'] / r['raw_paced']:>7.2f}x"
     print(
         f"{n:>6} {'yes' if lidar else 'no':>5} {stack:>16} {r['rtf']:>6.2f}{'' if r['rtf'] >= HELD else '*':1}"
         + "".join(f" {ms[role]:>8.1f}" for role in ROLES)
@@ -362,7 +396,8 @@ def main() -> int:
     print(
         f"{'robots':>6} {'lidar':>5} {'stack':>16} {'RTF':>7}"
         + "".join(f" {role[:8]:>8}" for role in ROLES)
-        + f" {'total':>7} {'/solver':>8} {'sim/solv':>8} {'raw':>7} {'sim/raw':>8}"
+        + f" {'total':>7} {'/solver':>8} {'sim/solv':>8} {'raw':>7} {'sim/raw':>8} {'solv/raw':>8}"
+        + f" {'paced':>7} {'s/paced':>8}"
     )
     results = {}
     if args.merge:
@@ -376,14 +411,19 @@ def main() -> int:
             for stack in args.stacks:
                 for physics in args.physics:
                     if not lidar and (n, physics) not in raw:  # between the launches: nothing else runs
-                        raw[n, physics] = raw_pybullet(n, physics)
+                        raw[n, physics] = (
+                            raw_pybullet(n, physics),
+                            raw_pybullet(n, physics, paced=True) if args.real_time_factor == 1.0 else None,
+                        )
                     for workers in args.workers:
                         r = case(
                             n, lidar, stack, args.seconds, master=master, rtf=args.real_time_factor, physics=physics,
                             workers=workers,
                         )  # fmt: skip
                         if not lidar:
-                            r["raw"] = raw[n, physics]
+                            r["raw"], paced = raw[n, physics]
+                            if paced is not None:
+                                r["raw_paced"] = paced
                         label = stack + (f"+{physics}" if physics != "default" else "")
                         label += f"+w{workers}" if workers > 1 else ""
                         results.setdefault((lidar, label), {})[n] = r
@@ -417,6 +457,8 @@ def verdicts(results) -> bool:
         every = [r for (_, s), points in results.items() if s == stack for r in points.values()]
         stack_ratio = max(sum(r[role] for role in ROLES) / r["solver"] for r in every)
         sim_ratio = max(simulator_cpu(r) / r["solver"] for r in every)
+        solver_raw = [r["solver"] / r["raw"] for r in every if "raw" in r and "+w" not in stack]
+        solver_paced = [r["solver"] / r["raw_paced"] for r in every if "raw_paced" in r and "+w" not in stack]
         held, held_lidar = largest_held(False, stack), largest_held(True, stack)
         fleet = TARGET_WORKER_FLEET if "+w" in stack else TARGET_FLEET
         checks = [
@@ -429,6 +471,14 @@ def verdicts(results) -> bool:
                 sim_ratio,
             ),
         ]
+        if solver_raw:
+            worst = max(solver_raw)
+            what = f"solver in the node at most {TARGET_SOLVER_RAW:g} x the same steps raw, back to back"
+            checks.append((what, worst <= TARGET_SOLVER_RAW, worst))
+        if solver_paced:
+            worst = max(solver_paced)
+            what = f"solver in the node at most {TARGET_SOLVER_RAW:g} x the same steps raw at the node's pace"
+            checks.append((what, worst <= TARGET_SOLVER_RAW, worst))
         for what, met, figure in checks:
             ok &= met
             figure = f"{figure:.2f} x" if isinstance(figure, float) else figure
