@@ -20,14 +20,30 @@ import sys
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from multiprocessing import get_context
-from typing import List, Optional
+from typing import Dict, List, Optional
 
 from tqdm import tqdm
+
+from thorvald_model import load_robot_config
+from thorvald_model.errors import ThorvaldModelError
 
 from .errors import DesignError, StudyError
 from .report import write_report
 from .report.table import results_table, write_csv
-from .runs import Job, done, empty_results, merge, prepare, read_results, run_one, write_json, write_results
+from .runs import (
+    TIMING,
+    Job,
+    done,
+    empty_results,
+    longest_first,
+    merge,
+    prepare,
+    read_results,
+    read_timing,
+    run_one,
+    write_json,
+    write_results,
+)
 from .search import run_search, search_table
 from .study import load_study
 
@@ -95,7 +111,7 @@ def _study(args) -> int:
                 if scenario in dict(study.scenarios):
                     merge(results, {"candidate": name, "scenario": scenario, "mass_kg": kept.get("mass_kg"),
                                     "result": result}, study)  # fmt: skip
-    todo = [job for job in jobs if not done(results, job)]
+    todo = longest_first([job for job in jobs if not done(results, job)], read_timing(args.out), drive_counts(jobs))
     write_results(args.out, results)
     skipped = len(jobs) - len(todo)
     try:
@@ -131,6 +147,19 @@ def _study(args) -> int:
 
 
 SCHEDULER_TIMEOUT = 10.0  # [s] to reach a Dask scheduler
+
+
+def drive_counts(jobs: List[Job]) -> Dict[str, int]:
+    """Each candidate's number of drives (how long its runs take grows with it); a candidate whose file
+    cannot be read is left out (its runs fail at once)."""
+    counts: Dict[str, int] = {}
+    for job in jobs:
+        if job.candidate not in counts:
+            try:
+                counts[job.candidate] = len(load_robot_config(job.robot_file).drives)
+            except ThorvaldModelError:
+                continue
+    return counts
 
 
 def counted(n: int, one: str, many: str = "") -> str:
@@ -169,9 +198,6 @@ class _DaskExecutor:
     def __exit__(self, *exc):
         self.executor.shutdown(wait=True)
         self.client.close()
-
-
-TIMING = "timing.json"  # each run's simulated and wall seconds (apart from results.json, which repeats to the byte)
 
 
 def _run(todo: List[Job], pool, workers: int, *, results, study, out_dir: str, timing: List[dict]) -> None:

@@ -13,7 +13,7 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
 from thorvald_sim.physics.robot import MotorLoad
 from thorvald_sim.physics.simulation import Camera, save_png
-from thorvald_sim.tools.runner import RobotSession, RunOptions, Sample
+from thorvald_sim.tools.runner import RobotSession, RunOptions, Sample, robot_urdf
 from thorvald_sim.world import parse_world
 
 from .scenarios.kind import Pose, Twist
@@ -22,8 +22,17 @@ from .scenarios.kind import Pose, Twist
 class LabSession:
     """One drive: the candidate spawned in a world; base_link's pose recorded at every control instant."""
 
-    def __init__(self, robot_file: str, options: RunOptions, world: Mapping, name: str, label: str = ""):
-        self._session = RobotSession(robot_file, options, parse_world(dict(world), source=name))
+    def __init__(
+        self,
+        robot_file: str,
+        options: RunOptions,
+        world: Mapping,
+        name: str,
+        label: str = "",
+        *,
+        urdf: Optional[str] = None,
+    ):
+        self._session = RobotSession(robot_file, options, parse_world(dict(world), source=name), urdf=urdf)
         self.world = world
         self.label = label  # what the drive is, for the report's maps ("climb 14 deg")
         self.outcome = ""  # what came of it, set by the scenario ("ok", "traction", ...)
@@ -145,6 +154,7 @@ class Lab:
         # [m] the simulated robot's centre of mass in base_link (LabSession.centre_of_mass), from the
         # first session: what a scenario compares with its description's; None before any session
         self.centre_of_mass: Optional[Tuple[float, float, float]] = None
+        self._urdf: Optional[str] = None  # the robot's description, made at the first session
 
     def session(
         self,
@@ -161,7 +171,10 @@ class Lab:
         options = RunOptions(
             as_built=self.as_built, seed=self.seed, x=x, y=y, z=z, yaw=yaw, roll=roll, physics_rate=self.physics_rate
         )
-        session = LabSession(self.robot_file, options, world, name=f"<scenario world {self.sessions}>", label=label)
+        if self._urdf is None:  # one description for every session: their options differ in pose alone
+            self._urdf = robot_urdf(self.robot_file, options)
+        name = f"<scenario world {self.sessions}>"
+        session = LabSession(self.robot_file, options, world, name=name, label=label, urdf=self._urdf)
         session.on_close = self._keep
         if self.centre_of_mass is None:
             self.centre_of_mass = session.centre_of_mass

@@ -203,6 +203,33 @@ def done(results: Mapping[str, Any], job: Job) -> bool:
     return bool(entry) and job.scenario in entry.get("scenarios", {})
 
 
+TIMING = "timing.json"  # each run's simulated and wall seconds (apart from results.json, which repeats to the byte)
+
+
+def read_timing(out_dir: str) -> Dict[str, float]:
+    """An earlier study's wall time of each run in out_dir [s], by the run's label; {} if none."""
+    try:
+        with open(os.path.join(out_dir, TIMING), encoding="utf-8") as f:
+            runs = json.load(f)["runs"]
+        return {str(r["run"]): float(r["wall_s"]) for r in runs}
+    except (OSError, ValueError, KeyError, TypeError):
+        return {}
+
+
+def longest_first(jobs: List[Job], timed: Mapping[str, float], drives: Mapping[str, int]) -> List[Job]:
+    """The jobs in the order to start them, the longest first, so that the workers end together (the
+    runs started last are short ones). A run's length is its wall time in ``timed`` (an earlier study's,
+    by label) or else its scenario's ``cost`` times the candidate's ``drives`` over four; equal ones
+    keep the study's order."""
+
+    def length(job: Job) -> float:
+        if job.label in timed:
+            return timed[job.label]
+        return SCENARIOS[job.scenario].cost * drives.get(job.candidate, 4) / 4.0
+
+    return sorted(jobs, key=length, reverse=True)
+
+
 def read_results(out_dir: str) -> Optional[Dict[str, Any]]:
     try:
         with open(os.path.join(out_dir, RESULTS), encoding="utf-8") as f:

@@ -71,6 +71,8 @@ class PluginKind:
     own_description: str = ""
 
 
+_WORKSPACE_EXPORTS: Dict[Tuple[str, str, str], List[Tuple[str, str]]] = {}  # PluginLoader._description_files
+
 CALCULATORS = PluginKind(
     export="thorvald_base",
     base_class="thorvald_base.kinematics:BaseCalculator",
@@ -169,6 +171,17 @@ class PluginLoader:
         return None
 
     def _description_files(self) -> List[Tuple[str, str]]:
+        """(package, description file) of every export of this kind. The workspace's (no rospack
+        given) is searched once per process and ROS_PACKAGE_PATH: reading every package's manifest
+        takes about 90 ms, which a design study's runs paid at every robot they spawned."""
+        if self._rospack is not None:
+            return self._search()
+        key = (self.kind.export, self.kind.attribute, os.environ.get("ROS_PACKAGE_PATH", ""))
+        if key not in _WORKSPACE_EXPORTS:
+            _WORKSPACE_EXPORTS[key] = self._search()
+        return list(_WORKSPACE_EXPORTS[key])
+
+    def _search(self) -> List[Tuple[str, str]]:
         import rospkg  # noqa: PLC0415
 
         rp = self._rp()

@@ -157,4 +157,5 @@ DRAWBAR = ScenarioKind(
     metrics=METRICS,
     procedure=procedure,
     more=more,
+    cost=1.1,  # [s] the standard robot's run (ScenarioKind.cost)
 )

@@ -281,4 +281,5 @@ GRADEABILITY = ScenarioKind(
     metrics=METRICS,
     procedure=procedure,
     check=check,
+    cost=12.0,  # [s] the standard robot's run (ScenarioKind.cost)
 )

@@ -149,6 +149,10 @@ class ScenarioKind:
     # further surface, each declared by its metric's declaration): the table's, the CSV's and the
     # report's columns after ``results``
     more: Callable[[Mapping[str, Any]], Tuple[str, ...]] = field(default=lambda params: ())
+    # [s] about what a run of it takes the standard robot (four drives) in one worker on the project's
+    # machine with its default parameters: a study starts its longest runs first, and guesses their
+    # length from this (times the candidate's drives over four) where no earlier run was timed
+    cost: float = 1.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "metrics", tuple(self.metrics))

@@ -350,4 +350,5 @@ RAILS = ScenarioKind(
     metrics=METRICS,
     procedure=procedure,
     check=check,
+    cost=0.1,  # [s] the standard robot's run (ScenarioKind.cost)
 )

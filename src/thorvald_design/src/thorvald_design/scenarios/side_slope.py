@@ -176,4 +176,5 @@ SIDE_SLOPE = ScenarioKind(
     metrics=METRICS,
     procedure=procedure,
     check=check,
+    cost=3.0,  # [s] the standard robot's run (ScenarioKind.cost)
 )

@@ -150,4 +150,5 @@ TURNING = ScenarioKind(
     keys=KEYS,
     metrics=METRICS,
     procedure=procedure,
+    cost=1.1,  # [s] the standard robot's run (ScenarioKind.cost)
 )

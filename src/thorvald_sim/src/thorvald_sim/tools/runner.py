@@ -249,6 +249,15 @@ class _InProcessPorts(Ports):
         return self.drives
 
 
+def robot_urdf(robot_file: str, options: RunOptions = RunOptions()) -> str:
+    """The robot's description as a session of these options spawns it (generate_urdf: about 0.2 s).
+    A caller that makes many sessions of one robot file with the same ``tf_prefix``, ``model_extras``
+    and ``robot_name`` makes it once and hands it to each (``RobotSession(..., urdf=)``)."""
+    return generate_urdf(
+        robot_file, tf_prefix=options.tf_prefix, model_extras=options.model_extras, robot_name=options.robot_name
+    )
+
+
 class RobotSession:
     """One robot in a simulation of its own, driven by its base_driver core in lockstep, for as long
     as its caller wants: what :func:`run_robot` runs a list of commands on, and what a caller who
@@ -257,18 +266,24 @@ class RobotSession:
     ``world`` (a loaded world) stands in for ``options.world`` when given. :meth:`run` advances
     simulated time; between runs the caller reads the robot (:attr:`robot`: ground truth, the joints'
     motor torques) and may push it (:meth:`push`). Close it (or use it as a context manager): it
-    holds a pybullet DIRECT client.
+    holds a pybullet DIRECT client. ``urdf``: the robot's description as :func:`robot_urdf` makes it
+    for this file and these options, made once by a caller of many sessions; made here when None.
     """
 
-    def __init__(self, robot_file: str, options: RunOptions = RunOptions(), world: Optional[WorldConfig] = None):
+    def __init__(
+        self,
+        robot_file: str,
+        options: RunOptions = RunOptions(),
+        world: Optional[WorldConfig] = None,
+        *,
+        urdf: Optional[str] = None,
+    ):
         self.options = options
         self.config = config = load_robot_config(robot_file)
         self.driver = driver = DriverParams.from_dict(
             {**options.driver, "base_handle": "simulated_joints", "lockstep": True}
         )
-        urdf = generate_urdf(
-            robot_file, tf_prefix=options.tf_prefix, model_extras=options.model_extras, robot_name=options.robot_name
-        )
+        self.urdf = urdf if urdf is not None else robot_urdf(robot_file, options)
         as_built = for_simulator(as_built_for(options.as_built, config), config) if options.as_built else None
         physics = physics_settings(options.physics, options.physics_rate, options.solver_iterations)  # ValueError
         self.world = world if world is not None else load_world(resolve_world(options.world))
@@ -288,7 +303,7 @@ class RobotSession:
                 if body.actor is not None:  # moved by its script
                     self.engine.gazebo.animate(body.name, body.actor)
             pose = Pose2D(options.x, options.y, options.z, options.yaw, options.roll, options.pitch)
-            self.robot = self.sim.spawn(options.robot_name, urdf, pose, as_built)
+            self.robot = self.sim.spawn(options.robot_name, self.urdf, pose, as_built)
             calculator = load_calculator(config, estimator=driver.estimator, projection=driver.projection)
             self.drives = _SimulatedDrives(self.robot)
             handle = create_base_handle(config, driver, _InProcessPorts(self.drives))
