@@ -20,7 +20,7 @@ import sys
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from multiprocessing import get_context
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Set, Tuple
 
 from tqdm import tqdm
 
@@ -126,8 +126,9 @@ def _study(args) -> int:
     )
     started = time.monotonic()
     timing: List[dict] = []
+    drawn: Set[Tuple[str, str]] = set()  # the runs whose tracks plot their worker drew
     with executor:
-        _run(todo, executor, workers, results=results, study=study, out_dir=args.out, timing=timing)
+        _run(todo, executor, workers, results=results, study=study, out_dir=args.out, timing=timing, drawn=drawn)
     wall = time.monotonic() - started
     write_json(
         os.path.join(args.out, TIMING),
@@ -137,7 +138,7 @@ def _study(args) -> int:
     write_results(args.out, results)
     write_csv(os.path.join(args.out, "results.csv"), results, study)
     print(results_table(results, study))
-    page = write_report(args.out, results, study, pareto=study.pareto)
+    page = write_report(args.out, results, study, pareto=study.pareto, drawn=drawn)
     print(f"design_study: the report: {page}", file=sys.stderr)
     print(
         f"design_study: {len(todo)} runs in {time.monotonic() - started:.1f} s; results in {args.out}", file=sys.stderr
@@ -200,7 +201,17 @@ class _DaskExecutor:
         self.client.close()
 
 
-def _run(todo: List[Job], pool, workers: int, *, results, study, out_dir: str, timing: List[dict]) -> None:
+def _run(
+    todo: List[Job],
+    pool,
+    workers: int,
+    *,
+    results,
+    study,
+    out_dir: str,
+    timing: List[dict],
+    drawn: Set[Tuple[str, str]],
+) -> None:
     """Submits every run to the pool and gathers each result into results.json as it ends; the
     progress bar names the runs that are running (a line a run without a terminal)."""
     if not todo:
@@ -218,6 +229,8 @@ def _run(todo: List[Job], pool, workers: int, *, results, study, out_dir: str, t
                 run = future.result()
                 if "timing" in run:
                     timing.append({"run": job.label, **run["timing"]})
+                if run.get("drawn"):
+                    drawn.add((job.candidate, job.scenario))
                 merge(results, run, study)
                 write_results(out_dir, results)
                 bar.update(1)

@@ -114,7 +114,10 @@ def run_one(job: Job) -> Dict[str, Any]:
     out["result"] = result
     out["timing"] = {"simulated_s": round(lab.simulated, 3), "wall_s": round(time.monotonic() - started, 3)}
     if job.out_dir:
+        from .report import draw_tracks  # noqa: PLC0415 (the report imports this module)
+
         write_tracks(os.path.join(job.out_dir, "tracks", safe_name(job.candidate), job.scenario + ".json"), lab.drives)
+        out["drawn"] = not draw_tracks(job.out_dir, job.candidate, job.scenario)  # the page's plot, drawn here
         picture = os.path.join(job.out_dir, "pictures", safe_name(job.candidate) + ".png")
         if not os.path.exists(picture):
             take_picture(Lab(job.robot_file, job.as_built, job.seed), picture)

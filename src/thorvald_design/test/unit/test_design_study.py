@@ -217,6 +217,11 @@ def test_resume_keeps_what_is_done_and_runs_the_rest(study, tmp_path):
     assert done.returncode == 0, done.stderr[-2000:]
     assert "1 runs" in done.stderr or "7 already in" in done.stderr
     assert (out / "results.json").read_bytes() == (first / "results.json").read_bytes()
+    # its tracks plots drawn by the report (the kept runs') and by the worker (the run again) are the
+    # ones the first study's workers drew, to the byte: the page embeds them (the page ends with the
+    # study file's path, which differs)
+    pages = [(folder / "report.html").read_bytes().split(b'<h2 id="study">')[0] for folder in (out, first)]
+    assert pages[0] == pages[1] and b"fwd: turning" in pages[0]
 
 
 @pytest.mark.slow  # a process

@@ -37,7 +37,7 @@ shows is what its tracks file's marks say (a turn's circles, a headland's turns,
 import json
 import os
 import re
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
+from typing import Any, Collection, Dict, List, Mapping, Optional, Sequence, Tuple
 
 import matplotlib
 
@@ -72,10 +72,37 @@ TRACKS = "tracks"
 
 
 # ---- writing -----------------------------------------------------------------------------------------
-def write_report(out_dir: str, results: Mapping, study: Study, pareto: Optional[Tuple[str, str]] = None) -> str:
+def tracks_plot_path(out_dir: str, name: str, scenario: str) -> str:
+    """Where the plot of one run's tracks goes: DIR/plots/tracks_<candidate>_<scenario>.png."""
+    return os.path.join(out_dir, PLOTS, f"tracks_{safe_name(name)}_{scenario}.png")
+
+
+def draw_tracks(out_dir: str, name: str, scenario: str) -> str:
+    """Draws the plot of one run's tracks (DIR/tracks/<candidate>/<scenario>.json), the one the page
+    shows for it; what went wrong ("" if nothing). A study's worker draws it as its run ends, so that
+    the plots are drawn on every worker while the runs go on, not one after another after the last."""
+    path = tracks_plot_path(out_dir, name, scenario)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with matplotlib.rc_context(RC):
+        return _track_plot(f"{name}: {scenario}", out_dir, _tracks_source(name, scenario), path)
+
+
+def _tracks_source(name: str, scenario: str) -> str:
+    return os.path.join(TRACKS, safe_name(name), scenario + ".json")
+
+
+def write_report(
+    out_dir: str,
+    results: Mapping,
+    study: Study,
+    pareto: Optional[Tuple[str, str]] = None,
+    drawn: Collection[Tuple[str, str]] = (),
+) -> str:
     """Writes DIR/plots/*.png and DIR/report.html from the results (results.json's contents) and the
     study; returns the page's path. pareto: two columns ("gradeability.max_climb_deg",
-    "turning.turning_diameter_m") whose front to plot (ReportError if either is no column with a direction)."""
+    "turning.turning_diameter_m") whose front to plot (ReportError if either is no column with a direction).
+    drawn: the (candidate, scenario) runs whose tracks plot :func:`draw_tracks` drew from their
+    tracks as they are now (this study's runs, drawn in its workers): kept, not drawn again."""
     if pareto is not None:
         check_pareto(pareto, study)
     plots_dir = os.path.join(out_dir, PLOTS)
@@ -133,11 +160,14 @@ def write_report(out_dir: str, results: Mapping, study: Study, pareto: Optional[
         for name in names:
             plots = []
             for scenario, _ in study.scenarios:
-                source = os.path.join(TRACKS, safe_name(name), scenario + ".json")
+                source = _tracks_source(name, scenario)
                 if not os.path.isfile(os.path.join(out_dir, source)):
                     continue
-                path = os.path.join(plots_dir, f"tracks_{safe_name(name)}_{scenario}.png")
-                problem = _track_plot(f"{name}: {scenario}", out_dir, source, path)
+                path = tracks_plot_path(out_dir, name, scenario)
+                if (name, scenario) in drawn and os.path.isfile(path):
+                    problem = ""
+                else:
+                    problem = _track_plot(f"{name}: {scenario}", out_dir, source, path)
                 if problem:
                     notes.append(f"{name}: {scenario}: tracks not shown: {problem}")
                     continue
@@ -271,4 +301,4 @@ def _image(plot: Plot) -> Image:
         return Image("", f.read(), plot.caption)
 
 
-__all__ = ["PICTURES", "PLOTS", "REPORT", "TRACKS", "write_report"]
+__all__ = ["PICTURES", "PLOTS", "REPORT", "TRACKS", "draw_tracks", "tracks_plot_path", "write_report"]
