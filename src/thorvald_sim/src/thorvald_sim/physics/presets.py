@@ -2,7 +2,8 @@
 
 pybullet's cost per robot grows with the physics rate (collision detection and the solver run every
 step) and hardly with the solver's iterations (its solver stops early once the contacts are
-resolved: on 16 standard robots driving, 50, 20 and 10 iterations at 240 Hz cost the same). So the
+resolved: on 16 standard robots driving straight or crabbing, 50, 20 and 10 iterations at 240 Hz
+cost the same; turning robots keep more contact points and use every iteration). So the
 fleet preset halves the rate and keeps the iterations, which keep the contacts' accuracy at the
 longer step (20 iterations at 120 Hz took a differential robot's path 1.4 m off the default's over
 the paper's 80 m manoeuvre; 50 iterations 0.17 m). ``bench/physics_preset.py`` measures both
