@@ -104,7 +104,9 @@ def twist_of(k):
     return 0.30 + 0.02 * (k % 5), 0.3 if k % 2 else -0.3
 
 
-def launch_file(n: int, lidar: bool, stack: str, rtf: float = 1.0, physics: str = "default", *, workers: int = 1):
+def launch_file(
+    n: int, lidar: bool, stack: str, rtf: float = 1.0, physics: str = "default", *, workers: int = 1, drivers: int = 1
+):
     extras = f'<arg name="model_extras" value="{LIDAR}"/>' if lidar else ""
     robots = "\n".join(
         f'  <include file="$(find thorvald_bringup)/launch/sim_robot_in_world.launch"><arg name="ns" value="r{k}"/>'
@@ -113,11 +115,11 @@ def launch_file(n: int, lidar: bool, stack: str, rtf: float = 1.0, physics: str 
         f'<arg name="fleet_driver" value="{str(stack == "fleet").lower()}"/>{extras}</include>'
         for k in range(n)
     )
-    fleet = (
+    fleet = "".join(  # the robots dealt over `drivers` fleet_driver processes
         '  <include file="$(find thorvald_bringup)/launch/fleet_driver.launch">'
-        f'<arg name="robots" value="{" ".join(f"r{k}" for k in range(n))}"/></include>\n'
-        if stack == "fleet"
-        else ""
+        f'<arg name="name" value="{"fleet_driver" if d == 0 else f"fleet_driver_{d}"}"/>'
+        f'<arg name="robots" value="{" ".join(f"r{k}" for k in range(d, n, drivers))}"/></include>\n'
+        for d in range(drivers if stack == "fleet" else 0)
     )
     return (
         '<launch>\n  <include file="$(find thorvald_sim)/launch/simulator.launch">'
@@ -135,6 +137,7 @@ def role_of(pid: int, master_pid: int, parent: str = "") -> str:
         return "master"
     match = re.search(r"__name:=(\S+)", cmdline(pid))
     name = match.group(1) if match else ""
+    name = "fleet_driver" if name.startswith("fleet_driver_") else name  # a fleet split over processes
     if name in ROLES:
         return name
     return "workers" if parent in ("simulator", "workers") else "rest"
@@ -229,6 +232,7 @@ def case(
     rtf: float = 1.0,
     physics: str = "default",
     workers: int = 1,
+    drivers: int = 1,
 ):
     """{figure: value} of one fleet, on the benchmark's master."""
     import rospy  # noqa: PLC0415
@@ -239,7 +243,7 @@ def case(
 
     from thorvald_testing.topics import Latest  # noqa: PLC0415
 
-    xml = launch_file(n, lidar, stack, rtf, physics, workers=workers)
+    xml = launch_file(n, lidar, stack, rtf, physics, workers=workers, drivers=drivers)
     clock = Latest("/clock", Clock, queue_size=1)
     solver = []  # the simulator's figure per /diagnostics window while measuring [s per simulated s]
     measuring = threading.Event()
@@ -384,6 +388,9 @@ def main() -> int:
     parser.add_argument("--physics", nargs="+", default=["default"], choices=["default", "fleet"])
     parser.add_argument("--workers", type=int, nargs="+", default=[1], help="physics worker processes (1: none)")
     parser.add_argument(
+        "--fleet-drivers", type=int, default=1, help="fleet_driver processes of the fleet stack (robots dealt)"
+    )
+    parser.add_argument(
         "--real-time-factor", type=float, default=1.0, help="the simulator's pace (1; 0: as fast as it can)"
     )
     parser.add_argument("--plot", help="save the real-time factor against fleet size as this PNG")
@@ -418,7 +425,7 @@ def main() -> int:
                     for workers in args.workers:
                         r = case(
                             n, lidar, stack, args.seconds, master=master, rtf=args.real_time_factor, physics=physics,
-                            workers=workers,
+                            workers=workers, drivers=args.fleet_drivers,
                         )  # fmt: skip
                         if not lidar:
                             r["raw"], paced = raw[n, physics]
@@ -426,6 +433,7 @@ def main() -> int:
                                 r["raw_paced"] = paced
                         label = stack + (f"+{physics}" if physics != "default" else "")
                         label += f"+w{workers}" if workers > 1 else ""
+                        label += f"+d{args.fleet_drivers}" if stack == "fleet" and args.fleet_drivers > 1 else ""
                         results.setdefault((lidar, label), {})[n] = r
                         print_row(n, lidar, label, r)
     if args.json:
