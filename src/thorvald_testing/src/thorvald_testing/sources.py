@@ -83,16 +83,31 @@ def exception_classes_of(paths: Iterable[str]) -> Dict[str, Set[str]]:
         known |= names
 
 
-def imported_names(path: str, module: str) -> List[str]:
-    """Every module an import statement of the file names, at any depth (inside functions too),
-    relative imports resolved against the module's package; for ``from X import a`` both X and X.a
-    (a may be a module); and every literal handed to importlib.import_module or __import__. The
-    import checks read this where importing a module would miss an import inside a function."""
+_FUNCTIONS = (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)
+
+
+def _nodes(tree: ast.AST, inside_functions: bool):
+    if inside_functions:
+        yield from ast.walk(tree)
+        return
+    stack = [tree]
+    while stack:  # what runs when the module is imported: everything but a function's body
+        node = stack.pop()
+        yield node
+        stack += [c for c in ast.iter_child_nodes(node) if not isinstance(c, _FUNCTIONS)]
+
+
+def imported_names(path: str, module: str, inside_functions: bool = True) -> List[str]:
+    """Every module an import statement of the file names, at any depth (inside functions too, unless
+    ``inside_functions`` is false: then what importing the module runs), relative imports resolved
+    against the module's package; for ``from X import a`` both X and X.a (a may be a module); and
+    every literal handed to importlib.import_module or __import__. The import checks read this where
+    importing a module would miss an import inside a function."""
     with open(path, encoding="utf-8") as f:
         tree = ast.parse(f.read(), path)
     package = module if path.endswith("__init__.py") else module.rpartition(".")[0]
     names: List[str] = []
-    for node in ast.walk(tree):
+    for node in _nodes(tree, inside_functions):
         if isinstance(node, ast.Import):
             names += [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom):
