@@ -62,6 +62,13 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="ADDRESS",
         help="run on a Dask distributed scheduler (tcp://HOST:8786) instead of local worker processes",
     )
+    p.add_argument(
+        "--scheduler-timeout",
+        type=float,
+        default=SCHEDULER_TIMEOUT,
+        metavar="S",
+        help=f"with --scheduler: how long to try reaching it before giving up (default {SCHEDULER_TIMEOUT:g} s)",
+    )
     p.add_argument("--optimise", action="store_true", help="run the study's optimise: search instead of its candidates")
     p.add_argument(
         "--against-sweep",
@@ -175,7 +182,7 @@ def _executor(args, runs: int):
     if args.scheduler:
         from distributed import Client  # noqa: PLC0415 (only a study run on a cluster needs it)
 
-        client = Client(args.scheduler, timeout=SCHEDULER_TIMEOUT)
+        client = Client(args.scheduler, timeout=args.scheduler_timeout)
         workers = max(1, sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values()))
         return _DaskExecutor(client), workers, f"{workers} Dask workers at {args.scheduler}"
     workers = min(args.jobs or os.cpu_count() or 1, max(runs, 1))

@@ -366,6 +366,7 @@ def test_a_study_runs_on_a_dask_cluster_to_the_same_results(tmp_path):
 def test_an_unreachable_scheduler_is_one_clean_error(tmp_path):
     path = tmp_path / "study.yaml"
     path.write_text("candidates: {a: {robot: thorvald_ii_4wd4ws_std}}\nscenarios: {turning: {}}\n")
-    done = design_study(str(path), "--out", str(tmp_path / "out"), "--scheduler", "tcp://127.0.0.1:9", timeout=120)
+    address = ("--scheduler", "tcp://127.0.0.1:9", "--scheduler-timeout", "1")  # 10 s by default
+    done = design_study(str(path), "--out", str(tmp_path / "out"), *address, timeout=120)
     assert done.returncode == 2 and "cannot reach the scheduler tcp://127.0.0.1:9" in done.stderr
     assert "Traceback" not in done.stderr
