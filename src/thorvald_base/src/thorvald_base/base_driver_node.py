@@ -68,7 +68,16 @@ from sensor_msgs.msg import BatteryState, JointState
 from std_srvs.srv import SetBool, SetBoolResponse, Trigger, TriggerResponse
 
 from thorvald_model import ConfigError, config_to_dict, load_robot_config, parse_robot_config
-from thorvald_msgs.msg import BaseState, BatteryArray, CANFrame, ControllerArray, DriveCurrents, IOArray
+from thorvald_msgs.msg import (
+    BaseState,
+    BaseStateBatch,
+    BatteryArray,
+    CANFrame,
+    ControllerArray,
+    DriveCurrents,
+    DriveCurrentsBatch,
+    IOArray,
+)
 from thorvald_msgs.srv import (
     CanID,
     CanIDResponse,
@@ -155,18 +164,129 @@ class RosDriveTopics(DriveTopics):
 
 
 class RosPorts(Ports):
-    def __init__(self, names: Names):
+    """The node's topics; with fleet (a FleetDriveTopics), its drive topics are entries of the simulator's
+    fleet topics (sent at once when immediate: in lockstep, each robot's answer on its own)."""
+
+    def __init__(self, names: Names, fleet=None, immediate: bool = False):
         self.names = names
+        self.fleet = fleet
+        self.immediate = immediate
 
     def drive_topics(self, command_topic, state_topic, current_topic="drive_currents"):
         names = self.names
-        return RosDriveTopics(names.topic(command_topic), names.topic(state_topic), names.topic(current_topic))
+        topics = (names.topic(command_topic), names.topic(state_topic), names.topic(current_topic))
+        if self.fleet is not None:
+            return self.fleet.robot(*topics, immediate=self.immediate)
+        return RosDriveTopics(*topics)
+
+
+class FleetDriveTopics:
+    """A fleet_driver's side of the simulator's fleet topics (thorvald_sim.node.fleet_topics): every
+    robot's drive states and currents arrive in one message an instant, and its drive commands go in one
+    (:meth:`flush`, after the cycles of all robots of an instant), each entry named by the per-robot
+    topic it stands for."""
+
+    def __init__(self, simulator: str):
+        base = simulator.rstrip("/") + "/fleet/"
+        # a queue: in lockstep each robot's answer goes alone, and none may be dropped
+        self.pub = rospy.Publisher(base + "drive_commands", BaseStateBatch, queue_size=100)
+        self.lock = threading.Lock()
+        self.pending = {}  # per-robot command topic: its newest command, until flushed
+        self.on_states = {}  # per-robot topic: the robot's handler of its entry
+        self.on_currents = {}
+        self.throttle = Throttle()
+        self.subs = [
+            rospy.Subscriber(base + "drive_states", BaseStateBatch, self._states, queue_size=1),
+            rospy.Subscriber(base + "drive_currents", DriveCurrentsBatch, self._currents, queue_size=1),
+        ]
+
+    def robot(self, command_topic: str, state_topic: str, current_topic: str, immediate: bool) -> DriveTopics:
+        return _FleetRobotTopics(self, command_topic, state_topic, current_topic, immediate)
+
+    def send(self, topic: str, msg, immediate: bool) -> None:
+        with self.lock:
+            self.pending[topic] = msg  # a newer command replaces the one not sent yet
+        if immediate:
+            self.flush()
+
+    def flush(self) -> None:
+        """Every robot's commands since the last flush, in one message."""
+        with self.lock:
+            pending, self.pending = self.pending, {}
+        if pending:
+            batch = BaseStateBatch(topics=list(pending), messages=list(pending.values()))
+            batch.header.stamp = max(m.header.stamp for m in batch.messages)
+            self.pub.publish(batch)
+
+    def _states(self, msg):
+        self._dispatch(self.on_states, msg, "drive_states")
+
+    def _currents(self, msg):
+        self._dispatch(self.on_currents, msg, "drive_currents")
+
+    def _dispatch(self, handlers, msg, what):
+        if len(msg.topics) != len(msg.messages):
+            self.throttle.warn(
+                "fleet_driver: the simulator's fleet %s: %d topics for %d messages: refused",
+                what,
+                len(msg.topics),
+                len(msg.messages),
+            )
+            return
+        for topic, entry in zip(msg.topics, msg.messages):
+            handler = handlers.get(topic)
+            if handler is not None:
+                handler(entry)
+
+    def close(self):
+        for endpoint in (self.pub, *self.subs):
+            endpoint.unregister()
+
+
+class _FleetRobotTopics(DriveTopics):
+    """One robot's drive topics as entries of the fleet topics."""
+
+    def __init__(self, fleet: FleetDriveTopics, command_topic, state_topic, current_topic, immediate):
+        self.fleet = fleet
+        self.topics = (command_topic, state_topic, current_topic)
+        self.immediate = immediate
+        self.throttle = Throttle()
+
+    def send(self, commands, time, drives):
+        msg = conversions.command_msg(
+            rospy.Time.from_sec(time), commands, [d.max_steering_speed for d in drives], [d.channel for d in drives]
+        )
+        self.fleet.send(self.topics[0], msg, self.immediate)
+
+    def listen(self, on_states):
+        def on_message(msg):
+            try:
+                on_states(conversions.measured_drives(msg), msg.header.stamp.to_sec())
+            except ValueError as e:
+                self.throttle.warn("base_driver: %s ignored: %s", self.topics[1], e)
+
+        self.fleet.on_states[self.topics[1]] = on_message
+
+    def listen_currents(self, on_currents):
+        def on_message(msg):
+            try:
+                on_currents(*conversions.drive_currents(msg), msg.header.stamp.to_sec())
+            except ValueError as e:
+                self.throttle.warn("base_driver: %s ignored: %s", self.topics[2], e)
+
+        self.fleet.on_currents[self.topics[2]] = on_message
+
+    def close(self):
+        self.fleet.on_states.pop(self.topics[1], None)
+        self.fleet.on_currents.pop(self.topics[2], None)
+        self.fleet.flush()  # what it sent last (zero speeds, at shutdown) goes out
 
 
 class BaseDriverNode:
-    def __init__(self, names: Names = None, tf_broadcaster=None):
+    def __init__(self, names: Names = None, tf_broadcaster=None, fleet_topics=None):
         """names: where this robot's names are (default: this process's node); tf_broadcaster: one
-        to share (a fleet_driver's), else the node makes its own when it broadcasts odom."""
+        to share (a fleet_driver's), else the node makes its own when it broadcasts odom; fleet_topics:
+        a fleet_driver's FleetDriveTopics, for drive topics on the simulator's fleet topics."""
         self.names = names = names or Names()
         # log lines name the robot when several share a process
         self.label = names.label("base_driver")
@@ -188,7 +308,7 @@ class BaseDriverNode:
             )
         self.covariance = PoseCovariance(params.twist_covariance, len(self.config.drives))
         calculator = load_calculator(self.config, estimator=params.estimator, projection=params.projection)
-        handle = create_base_handle(self.config, params, RosPorts(names))
+        handle = create_base_handle(self.config, params, RosPorts(names, fleet_topics, immediate=self.lockstep))
         try:
             self.core = BaseDriverCore(self.config, calculator, handle, command_timeout=params.command_timeout)
             if params.calibration:
@@ -527,8 +647,9 @@ class BaseDriverNode:
             self.core.shutdown(rospy.get_time())
 
 
-def spin_together(drivers, rate: float, on_failure=None) -> None:
-    """The loop of one or several drivers at rate [Hz] of rospy time, one cycle each per instant.
+def spin_together(drivers, rate: float, on_failure=None, after_cycles=None) -> None:
+    """The loop of one or several drivers at rate [Hz] of rospy time, one cycle each per instant,
+    then after_cycles() if given (a fleet_driver sends the instant's commands on the fleet topics).
 
     A driver whose handle is closed leaves the loop; one whose cycle raises is handed to
     on_failure (a fleet_driver stops that robot and drives on) or, without it, stops the loop.
@@ -559,6 +680,8 @@ def spin_together(drivers, rate: float, on_failure=None) -> None:
                 alive = False
             if not alive:
                 drivers.remove(driver)
+        if after_cycles is not None:
+            after_cycles()
         try:
             ticker.sleep()
         except rospy.ROSTimeMovedBackwardsException:

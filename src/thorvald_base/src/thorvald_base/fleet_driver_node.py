@@ -19,6 +19,11 @@ Private parameters:
                    ``robot_description`` and ``joint_states`` as robot_state_publisher does
                    (default true; thorvald_base.state_publisher), so the fleet needs none per robot
 ``~publish_frequency``  robot_state_publisher's parameter of that name [Hz] (default 50)
+``~fleet_topics``  a simulator node's name (``/simulator``; fleet_driver.launch gives it): the robots
+                   on simulated drives (``simulated_joints``) take their drive states and currents
+                   from its fleet topics and send their commands on it, one message an instant for
+                   all (thorvald_sim.node.fleet_topics), instead of three topics per robot; default
+                   empty: each robot's own ``drive_commands``, ``drive_states``, ``drive_currents``
 =================  ===============================================================================
 
 One robot's fault stays in that robot: a robot whose configuration is refused is left out with a
@@ -36,7 +41,7 @@ import tf2_ros
 
 from thorvald_model import ConfigError
 
-from .base_driver_node import EXIT_REFUSED, BaseDriverNode, spin_together
+from .base_driver_node import EXIT_REFUSED, BaseDriverNode, FleetDriveTopics, spin_together
 from .errors import ThorvaldBaseError
 from .node_names import Names
 from .params import robot_namespaces
@@ -47,12 +52,14 @@ from .twist_mux_node import TwistMuxNode
 class Robot:
     """One robot of the fleet: its base_driver and its twist_mux."""
 
-    def __init__(self, ns: str, cmd_vel: str, joint_states: str, *, with_mux: bool, tf_broadcaster, state=None):
+    def __init__(
+        self, ns: str, cmd_vel: str, joint_states: str, *, with_mux: bool, tf_broadcaster, state=None, fleet=None
+    ):
         self.ns = ns
         if state is not None:
             state.add(ns)  # first: a robot without a usable description is refused before it drives
         self.driver = BaseDriverNode(
-            Names(ns, ns + "base_driver/", {"cmd_vel": cmd_vel, "joint_states": joint_states}), tf_broadcaster
+            Names(ns, ns + "base_driver/", {"cmd_vel": cmd_vel, "joint_states": joint_states}), tf_broadcaster, fleet
         )
         self.mux = None
         if with_mux:
@@ -80,10 +87,10 @@ def run_lockstep(driver) -> None:
         stop_failed(driver)
 
 
-def loops(drivers) -> list:
+def loops(drivers, after_cycles=None) -> list:
     """The threads that drive them: one loop for all drivers of one rate (a wake-up per instant of
-    /clock for the lot, not one per robot), one thread each in lockstep (each waits for its own drive
-    states)."""
+    /clock for the lot, not one per robot, then after_cycles()), one thread each in lockstep (each
+    waits for its own drive states)."""
     by_rate = {}
     threads = []
     for driver in drivers:
@@ -92,7 +99,9 @@ def loops(drivers) -> list:
         else:
             by_rate.setdefault(driver.rate, []).append(driver)
     for rate, group in by_rate.items():
-        threads.append(threading.Thread(target=spin_together, args=(group, rate, stop_failed), daemon=True))
+        threads.append(
+            threading.Thread(target=spin_together, args=(group, rate, stop_failed, after_cycles), daemon=True)
+        )
     return threads
 
 
@@ -103,6 +112,7 @@ def main():
         cmd_vel = str(rospy.get_param("~cmd_vel", "twist_mux/cmd_vel"))
         joint_states = str(rospy.get_param("~joint_states", "joint_states"))
         with_mux = bool(rospy.get_param("~twist_mux", True))
+        simulator = str(rospy.get_param("~fleet_topics", "") or "")
         state = None
         if rospy.get_param("~robot_state_publisher", True):
             state = FleetStatePublisher(float(rospy.get_param("~publish_frequency", 50.0)))
@@ -110,10 +120,12 @@ def main():
         rospy.logfatal("fleet_driver: refusing to start: %s", e)
         sys.exit(EXIT_REFUSED)
     broadcaster = tf2_ros.TransformBroadcaster()
+    fleet = FleetDriveTopics(rospy.resolve_name(simulator)) if simulator else None
     robots = []
     for ns in namespaces:
         try:
-            robots.append(Robot(ns, cmd_vel, joint_states, with_mux=with_mux, tf_broadcaster=broadcaster, state=state))
+            kwargs = {"with_mux": with_mux, "tf_broadcaster": broadcaster, "state": state, "fleet": fleet}
+            robots.append(Robot(ns, cmd_vel, joint_states, **kwargs))
         except (ConfigError, ThorvaldBaseError) as e:
             rospy.logfatal("fleet_driver: %sbase_driver refusing to start: %s", ns, e)
     if not robots:
@@ -123,7 +135,11 @@ def main():
         state.publish_static()
     for robot in robots:
         rospy.on_shutdown(robot.driver.shutdown)
-    rospy.loginfo("fleet_driver: driving %s", " ".join(r.ns.strip("/") for r in robots))
-    for thread in loops(r.driver for r in robots):
+    rospy.loginfo(
+        "fleet_driver: driving %s%s",
+        " ".join(r.ns.strip("/") for r in robots),
+        f" (simulated drives on {fleet.pub.resolved_name.rsplit('/', 1)[0]})" if fleet else "",
+    )
+    for thread in loops((r.driver for r in robots), fleet.flush if fleet else None):
         thread.start()
     rospy.spin()

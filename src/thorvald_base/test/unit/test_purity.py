@@ -31,6 +31,7 @@ NOT_PURE = {
     "thorvald_sim.node.sensor_io": "the simulator node's sensor topics",
     "thorvald_sim.node.robot_io": "the simulator node's robot topics and tf",
     "thorvald_sim.node.services": "the simulator node's services",
+    "thorvald_sim.node.fleet_topics": "the simulator node's fleet topics",
     "thorvald_sim.gazebo.api": "the simulator node's Gazebo API: services, topics, messages",
     "thorvald_sim.gazebo.bodies": "the Gazebo API in a world's bodies (pybullet)",
     "thorvald_teleop.joy_node": "a node",

@@ -6,7 +6,9 @@ Every robot but r4 and r10 drives its own twist (0.30 to 0.39 m/s; straight, lef
 r4 and r10 are never commanded. Then, mid-run, r2's base_driver process is killed (SIGKILL: no
 goodbye, the simulator's command timeout has to stop it) and r8, one of fleet_driver's, is sent
 NaN commands, which its base_driver refuses: those two stop, every other robot drives on as
-commanded, and the two idle ones stay put.
+commanded, and the two idle ones stay put. fleet_driver's robots exchange their drive topics with
+the simulator on its fleet topics (fleet_driver.launch's default), their own topics unread; a batch
+whose lengths differ and one naming a topic no robot follows, sent there meanwhile, change nothing.
 
 With physics workers (sim_fleet12_workers.test: the test node's ``~physics_workers`` 2, the simulator's
 strips split at x = 9), the same, and then worker 1 (its pid from the simulator's ``~worker_pids``),
@@ -29,8 +31,10 @@ import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Twist
+from rosgraph_msgs.msg import Log
 from sim_testing import Latest, planar, sim_sleep
 
+from thorvald_msgs.msg import BaseState, BaseStateBatch
 from thorvald_msgs.srv import DeleteRobot
 
 ROBOTS = [f"r{k}" for k in range(12)]
@@ -129,9 +133,22 @@ def kill_process_of(node):
     return pid
 
 
+def send_bad_batches():
+    """On the simulator's fleet command topic: lengths that differ, and a topic no robot follows."""
+    pub = rospy.Publisher("/simulator/fleet/drive_commands", BaseStateBatch, queue_size=10)
+    deadline = time.time() + 30
+    while pub.get_num_connections() == 0 and time.time() < deadline:
+        time.sleep(0.05)
+    stop = BaseState(prop_speed=[0.0] * 4, steer_pos=[0.0] * 4)
+    pub.publish(BaseStateBatch(topics=["/r9/drive_commands", "/r11/drive_commands"], messages=[stop]))
+    pub.publish(BaseStateBatch(topics=["/nobody/drive_commands"], messages=[stop]))
+
+
 class SimFleet12Test(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
+        cls.said = []  # /rosout from the start
+        rospy.Subscriber("/rosout", Log, cls.said.append, queue_size=1000)
         cls.truth = {r: Latest(f"/{r}/odometry/gazebo") for r in ROBOTS}
         cls.odometry = {r: Latest(f"/{r}/odometry/base_raw") for r in ROBOTS}
         cls.commander = FleetCommander()
@@ -153,6 +170,8 @@ class SimFleet12Test(unittest.TestCase):
         cls.mid = {r: planar(cls.truth[r].get()) for r in ROBOTS}
         cls.killed_pid = kill_process_of(f"/{KILLED}/base_driver")
         cls.commander.send(REFUSED, math.nan, 0.0)
+        cls.graph = dict(zip(("publishers", "subscribers"), rosgraph.Master("/sim_fleet12_test").getSystemState()))
+        send_bad_batches()  # the simulator's /rosout has long been connected: the robots came on it
         sim_sleep(PHASE)
         cls.second = {r: speeds(cls.truth[r]) for r in ROBOTS}
         cls.end = {r: planar(cls.truth[r].get()) for r in ROBOTS}
@@ -191,6 +210,24 @@ class SimFleet12Test(unittest.TestCase):
         rospy.loginfo("%s (NaN commands): %.4f m/s", REFUSED, speed)
         self.assertLess(speed, 0.02)
         self.assertTrue(self.fleet_driver_alive, "fleet_driver went down")
+
+    def test_fleet_driver_uses_the_fleet_topics_and_the_others_their_own(self):
+        def nodes(kind, topic):
+            return dict(self.graph[kind]).get(topic, [])
+
+        self.assertEqual(nodes("subscribers", "/simulator/fleet/drive_states"), ["/fleet_driver"])
+        self.assertEqual(nodes("publishers", "/simulator/fleet/drive_commands"), ["/fleet_driver"])
+        for r in ROBOTS:
+            with self.subTest(robot=r):
+                own = f"/{r}/base_driver"
+                fleet = ROBOTS.index(r) >= 6
+                self.assertEqual(nodes("subscribers", f"/{r}/drive_states"), [] if fleet else [own])
+                self.assertEqual(nodes("publishers", f"/{r}/drive_commands"), [] if fleet else [own])
+
+    def test_a_bad_fleet_batch_is_refused_with_a_warning(self):
+        warned = [m.msg for m in self.said if m.name == "/simulator" and m.level == Log.WARN]
+        self.assertTrue(any("2 topics for 1 messages: refused" in m for m in warned), warned)
+        self.assertTrue(any("no robot follows /nobody/drive_commands: ignored" in m for m in warned), warned)
 
     def test_the_others_drive_on(self):
         for r in ROBOTS:

@@ -73,11 +73,14 @@ class RobotIO:
         self.commands.restart_time()
         self.sensors.restart_time()
 
-    def reads(self, drives: bool, currents: bool, odometry: bool, tf_read: bool, now: float) -> Reads:
-        """What to read of this robot after the step to now: what is due, and read."""
+    def reads(
+        self, drives: bool, currents: bool, odometry: bool, tf_read: bool, now: float, *, fleet=(False, False)
+    ) -> Reads:
+        """What to read of this robot after the step to now: what is due, and read (here, or on the
+        fleet topics: fleet is whether their drive states and currents are read)."""
         return Reads(
-            states=drives and self.drive_pub.get_num_connections() > 0,
-            currents=currents and self.current_pub.get_num_connections() > 0,
+            states=drives and (fleet[0] or self.drive_pub.get_num_connections() > 0),
+            currents=currents and (fleet[1] or self.current_pub.get_num_connections() > 0),
             odometry=odometry and bool(self.odom_pub.get_num_connections() or (self.publish_tf and tf_read)),
             joints=odometry and bool(self.passive) and self.joint_pub.get_num_connections() > 0,
             sensors=self.sensors.requests(now),
@@ -114,22 +117,33 @@ class RobotIO:
         self.odom_pub.publish(msg)
         return conversions.odometry_transform(msg) if self.publish_tf and tf_read else None
 
-    def publish_drives(self, stamp):
+    def publish_drives(self, stamp, fleet=(None, None)):
         """drive_currents and drive_states at stamp: what was read after the step (those due, each if
-        somebody reads it)."""
+        somebody reads it); fleet: the fleet topics' lists of drive states and of drive currents, which
+        this robot's messages join as (its topic, message), each None while nobody reads it."""
         now = stamp.to_sec()
         got = self.robot.got
         # the currents first: a lockstep base_driver runs its cycle once the instant's states came
-        if got.currents and self.current_pub.get_num_connections():
-            currents = self.robot.drive_currents(now)
-            self.current_pub.publish(
-                conversions.currents_msg(stamp, [c[0] for c in currents], [c[1] for c in currents])
-            )
-        if got.states and self.drive_pub.get_num_connections():  # base_driver with measured drives
-            # its reader is there: in lockstep from its first drive states on, not its first answer
-            if self.node.lockstep and self.node.waits.published(self.robot.name, now):
-                rospy.loginfo("simulator: %s in lockstep", self.robot.name)
-            self.drive_pub.publish(conversions.state_msg(stamp, self.robot.drive_states(now)))
+        if got.currents:
+            here = self.current_pub.get_num_connections() > 0
+            if here or fleet[1] is not None:
+                currents = self.robot.drive_currents(now)
+                msg = conversions.currents_msg(stamp, [c[0] for c in currents], [c[1] for c in currents])
+                if here:
+                    self.current_pub.publish(msg)
+                if fleet[1] is not None:
+                    fleet[1].append((self.current_pub.resolved_name, msg))
+        if got.states:
+            here = self.drive_pub.get_num_connections() > 0  # base_driver with measured drives
+            if here or fleet[0] is not None:
+                # its reader is there: in lockstep from its first drive states on, not its first answer
+                if self.node.lockstep and self.node.waits.published(self.robot.name, now):
+                    rospy.loginfo("simulator: %s in lockstep", self.robot.name)
+                msg = conversions.state_msg(stamp, self.robot.drive_states(now))
+                if here:
+                    self.drive_pub.publish(msg)
+                if fleet[0] is not None:
+                    fleet[0].append((self.drive_pub.resolved_name, msg))
 
     def close(self):
         self.sub.unregister()

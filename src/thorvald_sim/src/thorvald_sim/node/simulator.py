@@ -44,6 +44,7 @@ from ..physics.engine import LocalPhysics, WorldSettings
 from ..physics.simulation import PerformanceMeter, simulator_statuses
 from ..physics.workers import WorkerPool
 from ..world import load_world, resolve_world
+from .fleet_topics import FleetTopics
 from .lockstep import Lockstep
 from .pacing import FollowerWait, Pacer
 from .params import SimulatorParams
@@ -91,6 +92,7 @@ class SimulatorNode:
         self.clock_pub = NonBlockingPublisher("/clock", Clock)
         self.tf = NonBlockingPublisher("/tf", TFMessage)
         self.tf_watch = TfWatcher(rospy.get_name(), self.io)  # other publishers of a robot's odom -> base_link
+        self.fleet = FleetTopics(self.io, self.lock)  # every robot's drive topics in one message an instant
         self.diagnostics = NonBlockingPublisher("/diagnostics", DiagnosticArray)
         self.meter = PerformanceMeter(1.0 / params.diagnostics_rate) if params.diagnostics_rate else None
         with self.lock:  # a request that comes as soon as a service is offered waits for both
@@ -185,7 +187,8 @@ class SimulatorNode:
         ticked, drives, currents, odometry = self.due(now)
         tf_read = odometry and self.tf.get_num_connections() > 0
         live = [io for io in self.io.values() if io.alive]
-        reads = {io.robot.name: io.reads(drives, currents, odometry, tf_read, now) for io in live}
+        fleet = self.fleet.read() if drives or currents else (False, False)  # the fleet topics' readers
+        reads = {io.robot.name: io.reads(drives, currents, odometry, tf_read, now, fleet=fleet) for io in live}
         stamp = rospy.Time.from_sec(now)
         # drive states and currents are read at the stamp's instant (whole nanoseconds), as they are published
         states = self.gazebo.wanted(now)
@@ -193,8 +196,10 @@ class SimulatorNode:
             self.worker_died(death)
         live = [io for io in live if io.alive]
         if drives or currents:
+            batches = ([] if fleet[0] else None, [] if fleet[1] else None)
             for io in live:
-                io.publish_drives(stamp)
+                io.publish_drives(stamp, batches)
+            self.fleet.publish(stamp, *batches)
         if ticked:
             self.publish_clock()
         if odometry:
