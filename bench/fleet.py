@@ -20,7 +20,9 @@ Stacks: ``per-robot`` is the stack as it is (base_driver and twist_mux processes
 each stack with each physics preset (simulator.launch's ``physics``: ``default``, or ``fleet``: 120
 Hz, about half the solver's CPU); a stack on a preset other than the default is labelled
 ``STACK+PRESET``. ``--workers`` runs each of them with each number of physics worker processes
-(simulator.launch's ``physics_workers``), labelled ``STACK+wN`` for N > 1.
+(simulator.launch's ``physics_workers``), labelled ``STACK+wN`` for N > 1. ``--fleet-topics on off``
+runs the fleet stack with its drive topics on the simulator's fleet topics (fleet_driver.launch's
+default, on) and on each robot's own (off, labelled ``STACK+own``).
 
 Figures per case, over ``--seconds`` simulated seconds after 5 s of warm-up:
 - real-time factor (simulated seconds per wall second); held: at least 0.95;
@@ -105,7 +107,15 @@ def twist_of(k):
 
 
 def launch_file(
-    n: int, lidar: bool, stack: str, rtf: float = 1.0, physics: str = "default", *, workers: int = 1, drivers: int = 1
+    n: int,
+    lidar: bool,
+    stack: str,
+    rtf: float = 1.0,
+    physics: str = "default",
+    *,
+    workers: int = 1,
+    drivers: int = 1,
+    fleet_topics: bool = True,
 ):
     extras = f'<arg name="model_extras" value="{LIDAR}"/>' if lidar else ""
     robots = "\n".join(
@@ -118,7 +128,8 @@ def launch_file(
     fleet = "".join(  # the robots dealt over `drivers` fleet_driver processes
         '  <include file="$(find thorvald_bringup)/launch/fleet_driver.launch">'
         f'<arg name="name" value="{"fleet_driver" if d == 0 else f"fleet_driver_{d}"}"/>'
-        f'<arg name="robots" value="{" ".join(f"r{k}" for k in range(d, n, drivers))}"/></include>\n'
+        f'<arg name="robots" value="{" ".join(f"r{k}" for k in range(d, n, drivers))}"/>'
+        f'<arg name="fleet_topics" value="{"/simulator" if fleet_topics else ""}"/></include>\n'
         for d in range(drivers if stack == "fleet" else 0)
     )
     return (
@@ -231,6 +242,7 @@ def case(
     physics: str = "default",
     workers: int = 1,
     drivers: int = 1,
+    fleet_topics: bool = True,
 ):
     """{figure: value} of one fleet, on the benchmark's master."""
     import rospy  # noqa: PLC0415
@@ -241,7 +253,7 @@ def case(
 
     from thorvald_testing.topics import Latest  # noqa: PLC0415
 
-    xml = launch_file(n, lidar, stack, rtf, physics, workers=workers, drivers=drivers)
+    xml = launch_file(n, lidar, stack, rtf, physics, workers=workers, drivers=drivers, fleet_topics=fleet_topics)
     clock = Latest("/clock", Clock, queue_size=1)
     solver = []  # the simulator's figure per /diagnostics window while measuring [s per simulated s]
     measuring = threading.Event()
@@ -389,6 +401,13 @@ def main() -> int:
         "--fleet-drivers", type=int, default=1, help="fleet_driver processes of the fleet stack (robots dealt)"
     )
     parser.add_argument(
+        "--fleet-topics",
+        nargs="+",
+        default=["on"],
+        choices=["on", "off"],
+        help="the fleet stack's drive topics on the simulator's fleet topics (on), each robot's own (off), or both",
+    )
+    parser.add_argument(
         "--real-time-factor", type=float, default=1.0, help="the simulator's pace (1; 0: as fast as it can)"
     )
     parser.add_argument("--plot", help="save the real-time factor against fleet size as this PNG")
@@ -420,10 +439,12 @@ def main() -> int:
                             raw_pybullet(n, physics),
                             raw_pybullet(n, physics, paced=True) if args.real_time_factor == 1.0 else None,
                         )
-                    for workers in args.workers:
+                    topics_of = args.fleet_topics if stack == "fleet" else ["on"]
+                    variants = [(w, t) for w in args.workers for t in topics_of]
+                    for workers, topics in variants:
                         r = case(
                             n, lidar, stack, args.seconds, master=master, rtf=args.real_time_factor, physics=physics,
-                            workers=workers, drivers=args.fleet_drivers,
+                            workers=workers, drivers=args.fleet_drivers, fleet_topics=topics == "on",
                         )  # fmt: skip
                         if not lidar:
                             r["raw"], paced = raw[n, physics]
@@ -432,6 +453,7 @@ def main() -> int:
                         label = stack + (f"+{physics}" if physics != "default" else "")
                         label += f"+w{workers}" if workers > 1 else ""
                         label += f"+d{args.fleet_drivers}" if stack == "fleet" and args.fleet_drivers > 1 else ""
+                        label += "+own" if topics == "off" else ""
                         results.setdefault((lidar, label), {})[n] = r
                         print_row(n, lidar, label, r)
     if args.json:
@@ -559,7 +581,12 @@ def describe(label: str) -> str:
     stack, *rest = label.split("+")
     words = [f"{stack} stack"]
     for part in rest:
-        words.append(f"{part[1:]} physics workers" if part[:1] == "w" and part[1:].isdigit() else f"{part} physics")
+        if part == "own":
+            words.append("each robot's own drive topics")
+        elif part[:1] in "wd" and part[1:].isdigit():
+            words.append(f"{part[1:]} {'physics workers' if part[0] == 'w' else 'fleet_drivers'}")
+        else:
+            words.append(f"{part} physics")
     return ", ".join(words)
 
 

@@ -10,7 +10,8 @@ is. On the fleet topics the same messages go as one per instant:
 ``~fleet/drive_states``        every robot's drive states due at the instant, while somebody reads it
 ``~fleet/drive_currents``      every robot's drive currents due at the instant, likewise
 ``~fleet/drive_commands``      followed: each entry as if it came on its own topic (``topics[i]``,
-                               e.g. ``/robot_1/drive_commands``: the robot spawned to follow it)
+                               e.g. ``/robot_1/drive_commands``: the robot spawned to follow it;
+                               an entry no robot follows is dropped, as a message nobody reads)
 =============================  ====================================================================
 
 Each entry names the per-robot topic it stands for, so it means exactly what it means there: the
@@ -68,8 +69,8 @@ class FleetTopics:
                 unknown.append(topic)
             else:
                 io.on_command(command)
-        if unknown:
-            rospy.logwarn_throttle(
+        if unknown:  # as a message on a topic nobody follows: a fleet_driver starts before its robots spawn
+            rospy.logdebug_throttle(
                 WARN_PERIOD, "simulator: %s: no robot follows %s: ignored", self.sub.resolved_name,
                 ", ".join(sorted(unknown)),
             )  # fmt: skip
