@@ -68,16 +68,7 @@ from sensor_msgs.msg import BatteryState, JointState
 from std_srvs.srv import SetBool, SetBoolResponse, Trigger, TriggerResponse
 
 from thorvald_model import ConfigError, config_to_dict, load_robot_config, parse_robot_config
-from thorvald_msgs.msg import (
-    BaseState,
-    BaseStateBatch,
-    BatteryArray,
-    CANFrame,
-    ControllerArray,
-    DriveCurrents,
-    DriveCurrentsBatch,
-    IOArray,
-)
+from thorvald_msgs.msg import BaseState, BatteryArray, CANFrame, ControllerArray, DriveCurrents, IOArray
 from thorvald_msgs.srv import (
     CanID,
     CanIDResponse,
@@ -120,42 +111,60 @@ def load_config(raw: dict, params: DriverParams, names: Names = None):
     return load_robot_config(params.robot_model), True
 
 
-class RosDriveTopics(DriveTopics):
-    """A handle's drive commands and measured states on the node's topics (thorvald_msgs/BaseState),
-    and the measured motor currents (thorvald_msgs/DriveCurrents)."""
+class MessageDriveTopics(DriveTopics):
+    """What a handle's drive topics do with messages, wherever they travel: the commands as a
+    BaseState (:meth:`command_msg`), and each arriving BaseState or DriveCurrents handed to the handle,
+    a malformed one refused with a throttled warning (:meth:`states_reader`, :meth:`currents_reader`)."""
 
-    def __init__(self, command_topic: str, state_topic: str, current_topic: str):
-        self.pub = rospy.Publisher(command_topic, BaseState, queue_size=1)
+    def __init__(self, state_topic: str, current_topic: str):
         self.state_topic = state_topic
         self.current_topic = current_topic
         self.throttle = Throttle()
-        self.sub = None
-        self.current_sub = None
 
-    def send(self, commands, time, drives):
-        self.pub.publish(
-            conversions.command_msg(
-                rospy.Time.from_sec(time), commands, [d.max_steering_speed for d in drives], [d.channel for d in drives]
-            )
+    @staticmethod
+    def command_msg(commands, time, drives):
+        return conversions.command_msg(
+            rospy.Time.from_sec(time), commands, [d.max_steering_speed for d in drives], [d.channel for d in drives]
         )
 
-    def listen(self, on_states):
+    def states_reader(self, on_states):
         def on_message(msg):
             try:
                 on_states(conversions.measured_drives(msg), msg.header.stamp.to_sec())
             except ValueError as e:
                 self.throttle.warn("base_driver: %s ignored: %s", self.state_topic, e)
 
-        self.sub = rospy.Subscriber(self.state_topic, BaseState, on_message, queue_size=1)
+        return on_message
 
-    def listen_currents(self, on_currents):
+    def currents_reader(self, on_currents):
         def on_message(msg):
             try:
                 on_currents(*conversions.drive_currents(msg), msg.header.stamp.to_sec())
             except ValueError as e:
                 self.throttle.warn("base_driver: %s ignored: %s", self.current_topic, e)
 
-        self.current_sub = rospy.Subscriber(self.current_topic, DriveCurrents, on_message, queue_size=1)
+        return on_message
+
+
+class RosDriveTopics(MessageDriveTopics):
+    """A handle's drive commands and measured states on the node's topics (thorvald_msgs/BaseState),
+    and the measured motor currents (thorvald_msgs/DriveCurrents)."""
+
+    def __init__(self, command_topic: str, state_topic: str, current_topic: str):
+        super().__init__(state_topic, current_topic)
+        self.pub = rospy.Publisher(command_topic, BaseState, queue_size=1)
+        self.sub = None
+        self.current_sub = None
+
+    def send(self, commands, time, drives):
+        self.pub.publish(self.command_msg(commands, time, drives))
+
+    def listen(self, on_states):
+        self.sub = rospy.Subscriber(self.state_topic, BaseState, self.states_reader(on_states), queue_size=1)
+
+    def listen_currents(self, on_currents):
+        reader = self.currents_reader(on_currents)
+        self.current_sub = rospy.Subscriber(self.current_topic, DriveCurrents, reader, queue_size=1)
 
     def close(self):
         for endpoint in (self.pub, self.sub, self.current_sub):
@@ -178,108 +187,6 @@ class RosPorts(Ports):
         if self.fleet is not None:
             return self.fleet.robot(*topics, immediate=self.immediate)
         return RosDriveTopics(*topics)
-
-
-class FleetDriveTopics:
-    """A fleet_driver's side of the simulator's fleet topics (thorvald_sim.node.fleet_topics): every
-    robot's drive states and currents arrive in one message an instant, and its drive commands go in one
-    (:meth:`flush`, after the cycles of all robots of an instant), each entry named by the per-robot
-    topic it stands for."""
-
-    def __init__(self, simulator: str):
-        base = simulator.rstrip("/") + "/fleet/"
-        # a queue: in lockstep each robot's answer goes alone, and none may be dropped
-        self.pub = rospy.Publisher(base + "drive_commands", BaseStateBatch, queue_size=100)
-        self.lock = threading.Lock()
-        self.pending = {}  # per-robot command topic: its newest command, until flushed
-        self.on_states = {}  # per-robot topic: the robot's handler of its entry
-        self.on_currents = {}
-        self.throttle = Throttle()
-        self.subs = [
-            rospy.Subscriber(base + "drive_states", BaseStateBatch, self._states, queue_size=1),
-            rospy.Subscriber(base + "drive_currents", DriveCurrentsBatch, self._currents, queue_size=1),
-        ]
-
-    def robot(self, command_topic: str, state_topic: str, current_topic: str, immediate: bool) -> DriveTopics:
-        return _FleetRobotTopics(self, command_topic, state_topic, current_topic, immediate)
-
-    def send(self, topic: str, msg, immediate: bool) -> None:
-        with self.lock:
-            self.pending[topic] = msg  # a newer command replaces the one not sent yet
-        if immediate:
-            self.flush()
-
-    def flush(self) -> None:
-        """Every robot's commands since the last flush, in one message."""
-        with self.lock:
-            pending, self.pending = self.pending, {}
-        if pending:
-            batch = BaseStateBatch(topics=list(pending), messages=list(pending.values()))
-            batch.header.stamp = max(m.header.stamp for m in batch.messages)
-            self.pub.publish(batch)
-
-    def _states(self, msg):
-        self._dispatch(self.on_states, msg, "drive_states")
-
-    def _currents(self, msg):
-        self._dispatch(self.on_currents, msg, "drive_currents")
-
-    def _dispatch(self, handlers, msg, what):
-        if len(msg.topics) != len(msg.messages):
-            self.throttle.warn(
-                "fleet_driver: the simulator's fleet %s: %d topics for %d messages: refused",
-                what,
-                len(msg.topics),
-                len(msg.messages),
-            )
-            return
-        for topic, entry in zip(msg.topics, msg.messages):
-            handler = handlers.get(topic)
-            if handler is not None:
-                handler(entry)
-
-    def close(self):
-        for endpoint in (self.pub, *self.subs):
-            endpoint.unregister()
-
-
-class _FleetRobotTopics(DriveTopics):
-    """One robot's drive topics as entries of the fleet topics."""
-
-    def __init__(self, fleet: FleetDriveTopics, command_topic, state_topic, current_topic, immediate):
-        self.fleet = fleet
-        self.topics = (command_topic, state_topic, current_topic)
-        self.immediate = immediate
-        self.throttle = Throttle()
-
-    def send(self, commands, time, drives):
-        msg = conversions.command_msg(
-            rospy.Time.from_sec(time), commands, [d.max_steering_speed for d in drives], [d.channel for d in drives]
-        )
-        self.fleet.send(self.topics[0], msg, self.immediate)
-
-    def listen(self, on_states):
-        def on_message(msg):
-            try:
-                on_states(conversions.measured_drives(msg), msg.header.stamp.to_sec())
-            except ValueError as e:
-                self.throttle.warn("base_driver: %s ignored: %s", self.topics[1], e)
-
-        self.fleet.on_states[self.topics[1]] = on_message
-
-    def listen_currents(self, on_currents):
-        def on_message(msg):
-            try:
-                on_currents(*conversions.drive_currents(msg), msg.header.stamp.to_sec())
-            except ValueError as e:
-                self.throttle.warn("base_driver: %s ignored: %s", self.topics[2], e)
-
-        self.fleet.on_currents[self.topics[2]] = on_message
-
-    def close(self):
-        self.fleet.on_states.pop(self.topics[1], None)
-        self.fleet.on_currents.pop(self.topics[2], None)
-        self.fleet.flush()  # what it sent last (zero speeds, at shutdown) goes out
 
 
 class BaseDriverNode:

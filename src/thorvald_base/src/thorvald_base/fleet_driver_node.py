@@ -40,13 +40,103 @@ import rospy
 import tf2_ros
 
 from thorvald_model import ConfigError
+from thorvald_msgs.msg import BaseStateBatch, DriveCurrentsBatch
 
-from .base_driver_node import EXIT_REFUSED, BaseDriverNode, FleetDriveTopics, spin_together
+from .base_driver_node import EXIT_REFUSED, BaseDriverNode, MessageDriveTopics, spin_together
+from .bases.handle import DriveTopics
 from .errors import ThorvaldBaseError
-from .node_names import Names
+from .node_names import Names, Throttle
 from .params import robot_namespaces
 from .state_publisher import FleetStatePublisher
 from .twist_mux_node import TwistMuxNode
+
+
+class FleetDriveTopics:
+    """A fleet_driver's side of the simulator's fleet topics (thorvald_sim.node.fleet_topics): every
+    robot's drive states and currents arrive in one message an instant, and its drive commands go in one
+    (:meth:`flush`, after the cycles of all robots of an instant), each entry named by the per-robot
+    topic it stands for."""
+
+    def __init__(self, simulator: str):
+        base = simulator.rstrip("/") + "/fleet/"
+        # a queue: in lockstep each robot's answer goes alone, and none may be dropped
+        self.pub = rospy.Publisher(base + "drive_commands", BaseStateBatch, queue_size=100)
+        self.lock = threading.Lock()
+        self.pending = {}  # per-robot command topic: its newest command, until flushed
+        self.on_states = {}  # per-robot topic: the robot's handler of its entry
+        self.on_currents = {}
+        self.throttle = Throttle()
+        self.subs = [
+            rospy.Subscriber(base + "drive_states", BaseStateBatch, self._states, queue_size=1),
+            rospy.Subscriber(base + "drive_currents", DriveCurrentsBatch, self._currents, queue_size=1),
+        ]
+
+    def robot(self, command_topic: str, state_topic: str, current_topic: str, immediate: bool) -> DriveTopics:
+        """One robot's drive topics (what RosPorts.drive_topics gives its handle)."""
+        return _FleetRobotTopics(self, command_topic, state_topic, current_topic, immediate)
+
+    def send(self, topic: str, msg, immediate: bool) -> None:
+        with self.lock:
+            self.pending[topic] = msg  # a newer command replaces the one not sent yet
+        if immediate:
+            self.flush()
+
+    def flush(self) -> None:
+        """Every robot's commands since the last flush, in one message."""
+        with self.lock:
+            pending, self.pending = self.pending, {}
+        if pending:
+            batch = BaseStateBatch(topics=list(pending), messages=list(pending.values()))
+            batch.header.stamp = max(m.header.stamp for m in batch.messages)
+            self.pub.publish(batch)
+
+    def _states(self, msg):
+        self._dispatch(self.on_states, msg, "drive_states")
+
+    def _currents(self, msg):
+        self._dispatch(self.on_currents, msg, "drive_currents")
+
+    def _dispatch(self, handlers, msg, what):
+        if len(msg.topics) != len(msg.messages):
+            self.throttle.warn(
+                "fleet_driver: the simulator's fleet %s: %d topics for %d messages: refused",
+                what,
+                len(msg.topics),
+                len(msg.messages),
+            )
+            return
+        for topic, entry in zip(msg.topics, msg.messages):
+            handler = handlers.get(topic)
+            if handler is not None:
+                handler(entry)
+
+    def close(self):
+        for endpoint in (self.pub, *self.subs):
+            endpoint.unregister()
+
+
+class _FleetRobotTopics(MessageDriveTopics):
+    """One robot's drive topics as entries of the fleet topics."""
+
+    def __init__(self, fleet: FleetDriveTopics, command_topic, state_topic, current_topic, immediate):
+        super().__init__(state_topic, current_topic)
+        self.fleet = fleet
+        self.command_topic = command_topic
+        self.immediate = immediate
+
+    def send(self, commands, time, drives):
+        self.fleet.send(self.command_topic, self.command_msg(commands, time, drives), self.immediate)
+
+    def listen(self, on_states):
+        self.fleet.on_states[self.state_topic] = self.states_reader(on_states)
+
+    def listen_currents(self, on_currents):
+        self.fleet.on_currents[self.current_topic] = self.currents_reader(on_currents)
+
+    def close(self):
+        self.fleet.on_states.pop(self.state_topic, None)
+        self.fleet.on_currents.pop(self.current_topic, None)
+        self.fleet.flush()  # what it sent last (zero speeds, at shutdown) goes out
 
 
 class Robot:
