@@ -58,6 +58,7 @@ it (the file, the key path, the value and the rule), exit status 1.
 import sys
 import threading
 import time
+import traceback
 
 import rospy
 import tf2_ros
@@ -605,4 +606,22 @@ def main():
         rospy.logfatal("base_driver: refusing to start: %s", e)
         sys.exit(EXIT_REFUSED)
     rospy.on_shutdown(node.shutdown)
-    node.spin()
+    # The loop in a thread of its own. rospy runs the shutdown hooks (node.shutdown, which takes the
+    # lock a cycle holds) inside its SIGINT handler, in the main thread: a Ctrl-C that came while the
+    # main thread's own cycle held the lock waited for it forever (one start in about ten in the
+    # rostest bad_config, a node still running 30 s after SIGINT).
+    failed = []
+
+    def loop():
+        try:
+            node.spin()
+        except Exception:  # as an uncaught exception in the main thread did: the traceback, exit 1
+            failed.append(traceback.format_exc())
+        finally:
+            rospy.signal_shutdown("the loop ended")
+
+    threading.Thread(target=loop, name="base_driver loop", daemon=True).start()
+    rospy.spin()
+    if failed:
+        sys.stderr.write(failed[0])
+        sys.exit(1)
