@@ -13,9 +13,10 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
 from thorvald_sim.physics.robot import MotorLoad
 from thorvald_sim.physics.simulation import Camera, save_png
-from thorvald_sim.tools.runner import RobotSession, RunOptions, Sample, robot_urdf
+from thorvald_sim.tools.runner import RobotSession, RunOptions, Sample, urdf_args
 from thorvald_sim.world import parse_world
 
+from .design import description_of
 from .scenarios.kind import Pose, Twist
 
 
@@ -172,7 +173,7 @@ class Lab:
             as_built=self.as_built, seed=self.seed, x=x, y=y, z=z, yaw=yaw, roll=roll, physics_rate=self.physics_rate
         )
         if self._urdf is None:  # one description for every session: their options differ in pose alone
-            self._urdf = robot_urdf(self.robot_file, options)
+            self._urdf = description_of(self.robot_file, **urdf_args(options))
         name = f"<scenario world {self.sessions}>"
         session = LabSession(self.robot_file, options, world, name=name, label=label, urdf=self._urdf)
         session.on_close = self._keep

@@ -249,13 +249,16 @@ class _InProcessPorts(Ports):
         return self.drives
 
 
+def urdf_args(options: RunOptions) -> Dict[str, str]:
+    """generate_urdf's arguments besides the robot file, as a session of these options spawns it."""
+    return {"tf_prefix": options.tf_prefix, "model_extras": options.model_extras, "robot_name": options.robot_name}
+
+
 def robot_urdf(robot_file: str, options: RunOptions = RunOptions()) -> str:
     """The robot's description as a session of these options spawns it (generate_urdf: about 0.2 s).
     A caller that makes many sessions of one robot file with the same ``tf_prefix``, ``model_extras``
     and ``robot_name`` makes it once and hands it to each (``RobotSession(..., urdf=)``)."""
-    return generate_urdf(
-        robot_file, tf_prefix=options.tf_prefix, model_extras=options.model_extras, robot_name=options.robot_name
-    )
+    return generate_urdf(robot_file, **urdf_args(options))
 
 
 class RobotSession:
