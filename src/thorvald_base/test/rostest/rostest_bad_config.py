@@ -12,6 +12,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 import tempfile
 import time
 import unittest
@@ -185,7 +186,9 @@ class BadConfigTest(unittest.TestCase):
             except subprocess.TimeoutExpired:
                 os.killpg(proc.pid, signal.SIGKILL)
                 out, err = proc.communicate(timeout=10)
-            self.fail(f"base_driver did not exit within 30 s of SIGINT; its threads:\n{out}\n{err}")
+            said = f"base_driver did not exit within 30 s of SIGINT; its threads:\n{out}\n{err}"
+            sys.stderr.write(said + "\n")  # into the test's log too: rosunit's XML drops a subTest's failure text
+            self.fail(said)
 
 
 if __name__ == "__main__":
