@@ -7,7 +7,7 @@ without a master. Stamps are ``rospy.Time``/``genpy.Time`` values the caller pas
 """
 
 import math
-from typing import Dict, List, Sequence, Tuple
+from typing import Any, Dict, List, Sequence, Tuple
 
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Quaternion, TransformStamped, Twist, TwistStamped
@@ -105,6 +105,22 @@ def currents_msg(stamp, prop_amps: Sequence[float], steer_amps: Sequence[float])
     msg = DriveCurrents(prop_amps=list(prop_amps), steer_amps=list(steer_amps))
     msg.header.stamp = stamp
     return msg
+
+
+def batch_msg(kind, stamp, entries):
+    """Several robots' messages in one (kind: BaseStateBatch or DriveCurrentsBatch, the simulator's
+    fleet topics); entries: (the per-robot topic a message stands for, the message)."""
+    msg = kind(topics=[topic for topic, _ in entries], messages=[m for _, m in entries])
+    msg.header.stamp = stamp
+    return msg
+
+
+def batch_entries(msg) -> List[Tuple[str, Any]]:
+    """(per-robot topic, message) of each entry of a batch; ValueError when its topics and messages
+    differ in number."""
+    if len(msg.topics) != len(msg.messages):
+        raise ValueError(f"{len(msg.topics)} topics for {len(msg.messages)} messages")
+    return list(zip(msg.topics, msg.messages))
 
 
 def drive_currents(msg: DriveCurrents) -> Tuple[List[float], List[float]]:

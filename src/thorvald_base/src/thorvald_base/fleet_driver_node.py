@@ -42,6 +42,7 @@ import tf2_ros
 from thorvald_model import ConfigError
 from thorvald_msgs.msg import BaseStateBatch, DriveCurrentsBatch
 
+from . import conversions
 from .base_driver_node import EXIT_REFUSED, BaseDriverNode, MessageDriveTopics, spin_together
 from .bases.handle import DriveTopics
 from .errors import ThorvaldBaseError
@@ -86,9 +87,8 @@ class FleetDriveTopics:
         with self.lock:
             pending, self.pending = self.pending, {}
         if pending:
-            batch = BaseStateBatch(topics=list(pending), messages=list(pending.values()))
-            batch.header.stamp = max(m.header.stamp for m in batch.messages)
-            self.pub.publish(batch)
+            stamp = max(m.header.stamp for m in pending.values())
+            self.pub.publish(conversions.batch_msg(BaseStateBatch, stamp, list(pending.items())))
 
     def _states(self, msg):
         self._dispatch(self.on_states, msg, "drive_states")
@@ -97,22 +97,15 @@ class FleetDriveTopics:
         self._dispatch(self.on_currents, msg, "drive_currents")
 
     def _dispatch(self, handlers, msg, what):
-        if len(msg.topics) != len(msg.messages):
-            self.throttle.warn(
-                "fleet_driver: the simulator's fleet %s: %d topics for %d messages: refused",
-                what,
-                len(msg.topics),
-                len(msg.messages),
-            )
+        try:
+            entries = conversions.batch_entries(msg)
+        except ValueError as e:
+            self.throttle.warn("fleet_driver: the simulator's fleet %s: %s: refused", what, e)
             return
-        for topic, entry in zip(msg.topics, msg.messages):
+        for topic, entry in entries:
             handler = handlers.get(topic)
             if handler is not None:
                 handler(entry)
-
-    def close(self):
-        for endpoint in (self.pub, *self.subs):
-            endpoint.unregister()
 
 
 class _FleetRobotTopics(MessageDriveTopics):

@@ -21,6 +21,7 @@ reader; its command entry as its answer). The per-robot topics stay, each publis
 
 import rospy
 
+from thorvald_base import conversions
 from thorvald_base.publishing import NonBlockingPublisher
 from thorvald_msgs.msg import BaseStateBatch, DriveCurrentsBatch
 
@@ -49,21 +50,20 @@ class FleetTopics:
         """The instant's batches: the currents first (as each robot's are), then the states; states and
         currents: lists of (per-robot topic, message), or None while nobody reads them."""
         if currents:
-            self.currents.publish(_batch(DriveCurrentsBatch, stamp, currents))
+            self.currents.publish(conversions.batch_msg(DriveCurrentsBatch, stamp, currents))
         if states:
-            self.states.publish(_batch(BaseStateBatch, stamp, states))
+            self.states.publish(conversions.batch_msg(BaseStateBatch, stamp, states))
 
     def on_commands(self, msg) -> None:
-        if len(msg.topics) != len(msg.messages):
-            rospy.logwarn_throttle(
-                WARN_PERIOD, "simulator: %s: %d topics for %d messages: refused", self.sub.resolved_name,
-                len(msg.topics), len(msg.messages),
-            )  # fmt: skip
+        try:
+            entries = conversions.batch_entries(msg)
+        except ValueError as e:
+            rospy.logwarn_throttle(WARN_PERIOD, "simulator: %s: %s: refused", self.sub.resolved_name, e)
             return
         with self.lock:
             following = {io.sub.resolved_name: io for io in self.robots.values()}
         unknown = []
-        for topic, command in zip(msg.topics, msg.messages):
+        for topic, command in entries:
             io = following.get(topic)
             if io is None:
                 unknown.append(topic)
@@ -74,13 +74,3 @@ class FleetTopics:
                 WARN_PERIOD, "simulator: %s: no robot follows %s: ignored", self.sub.resolved_name,
                 ", ".join(sorted(unknown)),
             )  # fmt: skip
-
-    def close(self) -> None:
-        for endpoint in (self.states, self.currents, self.sub):
-            endpoint.unregister()
-
-
-def _batch(kind, stamp, entries):
-    msg = kind(topics=[topic for topic, _ in entries], messages=[m for _, m in entries])
-    msg.header.stamp = stamp
-    return msg
