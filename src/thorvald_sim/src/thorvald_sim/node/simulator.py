@@ -22,7 +22,6 @@ base_driver does not report, ``drive_states`` and ``drive_currents``, each only 
 """
 
 import sys
-import threading
 import time
 
 import rospy
@@ -50,6 +49,7 @@ from .pacing import FollowerWait, Pacer
 from .params import SimulatorParams
 from .robot_io import WARN_PERIOD, TfWatcher
 from .services import SimulatorServices
+from .turns import SWITCH_INTERVAL, TurnLock
 
 EXIT_REFUSED = 1
 
@@ -80,7 +80,7 @@ class SimulatorNode:
         else:
             self.sim = LocalPhysics(settings, self.gui)
         self.physics = params.physics
-        self.lock = threading.RLock()
+        self.lock = TurnLock()  # the loop lets requests in between its steps (node.turns)
         self.io = {}
         # one grid of simulated time for everything periodic (thorvald_base.rate_grid): the step nearest
         # each multiple of a period, so 80 Hz at the default 240 Hz physics is every third step
@@ -128,6 +128,7 @@ class SimulatorNode:
                     for io in self.io.values():
                         io.apply(now, self.command_timeout)
                     ticked = self.step()
+            self.lock.let_waiters_in()
             if not paused and self.lockstep and ticked:
                 self.wait_for_answers()
             if self.meter is not None:
@@ -139,8 +140,7 @@ class SimulatorNode:
             self.pacer.stepped(self.sim.time)
 
     def wait_for_answers(self):
-        """Lockstep: holds the world until every robot in lockstep answered its last drive states; a
-        robot silent for the lockstep's timeout of wall time is let go (it joins again with its next command)."""
+        """Lockstep: the world held until each robot in lockstep answered (one silent for the timeout is let go)."""
         for name in self.waits.wait(rospy.is_shutdown):
             rospy.logwarn(
                 "simulator: %s did not answer its drive states for %.1f s: going on without it "
@@ -219,8 +219,7 @@ class SimulatorNode:
         rospy.loginfo("simulator: models back at their spawn poses")
 
     def restart_time(self) -> None:
-        """Simulated time back to zero (/gazebo/reset_simulation): /clock says 0 and everything periodic
-        starts again from there; nodes on /use_sim_time see time jump back, as with Gazebo."""
+        """Time back to zero (/gazebo/reset_simulation): everything periodic starts again, as with Gazebo."""
         self.sim.restart_time()
         for grid in (self.clock, self.odometry, self.drives, self.currents, self.gazebo.grid):
             grid.pause()
@@ -286,6 +285,7 @@ class SimulatorNode:
 
 def main():
     rospy.init_node("simulator")
+    sys.setswitchinterval(SWITCH_INTERVAL)  # requests' threads wait less for the loop's steps (node.turns)
     try:
         node = SimulatorNode()
     except (ConfigError, ParameterError, WorkerError) as e:
