@@ -2,11 +2,11 @@
 """Odometry calibration beyond the profile it was built on: three robots of different layouts, as built
 from two profiles, each calibrated as a real robot is and validated on two drives it never saw.
 
-    python bench/calibration_heading.py [--robots R ...] [--profiles field workshop] [--seed 4] [--out DIR]
+    python bench/calibration_heading.py [--robots R ...] [--profiles field workshop [rigid]] [--seed 4] [--out DIR]
 
 For each robot (default: the paper's Figure 7 robot thorvald_ii_6wd6ws_asym, the standard 4WD4WS, the
 2WD differential robot) and profile (``field``: tyres loaded and soft, +-1 % each, homing within +-0.5
-degrees, encoders counting; ``workshop``: rigid tyres within +-0.85 %, homing within +-0.3 degrees), as a
+degrees, encoders counting; ``workshop``: pneumatic tyres within +-0.85 %, homing within +-0.3 degrees), as a
 user types it:
 
 1. ``calibration_drive --as-built PROFILE:SEED --ground-truth gnss``: the calibration manoeuvre against
@@ -136,7 +136,7 @@ def one_robot(robot: str, profile: str, seed: int, root: str):
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robots", nargs="+", default=list(ROBOTS))
-    parser.add_argument("--profiles", nargs="+", default=list(PROFILES), choices=PROFILES)
+    parser.add_argument("--profiles", nargs="+", default=list(PROFILES), choices=(*PROFILES, "rigid"))
     parser.add_argument("--seed", type=int, default=4)
     parser.add_argument("--jobs", type=int, default=1, help="robots calibrated and driven at once (default 1)")
     parser.add_argument("--out", metavar="DIR", help="keep everything here and run only what is missing")

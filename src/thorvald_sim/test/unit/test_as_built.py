@@ -128,15 +128,22 @@ def test_the_field_profile_is_seeded_and_within_its_tolerances():
     assert all(d.steering_offset == 0 for d in draw_as_built("field:3", DIFF).drives)
 
 
-def test_the_workshop_profile_is_radii_and_homing_alone():
+def test_the_workshop_profile_is_radii_and_homing_alone_on_pneumatic_tyres():
     drawn = [draw_as_built(f"workshop:{s}", STD) for s in range(200)]
     for built in drawn:
-        assert not built.encoders and built.loaded == 0.0 and built.tyre_deflection == 0.0
+        assert not built.encoders and built.loaded == 0.0
+        assert built.tyre_deflection == pytest.approx(0.045 * STD.drives[0].r_wheel)  # 9 mm, not rigid
         for d, conf in zip(built.drives, STD.drives):
             assert abs(d.r_wheel / conf.r_wheel - 1) <= 0.0085
             assert abs(d.steering_offset) <= math.radians(0.3)
     scales = [d.drives[0].r_wheel / STD.drives[0].r_wheel - 1 for d in drawn]
     assert min(scales) < -0.007 and max(scales) > 0.007  # uniform over +-0.85 %
+
+
+def test_the_rigid_profile_is_the_workshops_draw_on_rigid_tyres():
+    for seed in range(20):
+        workshop, rigid = draw_as_built(f"workshop:{seed}", STD), draw_as_built(f"rigid:{seed}", STD)
+        assert rigid.drives == workshop.drives and rigid.tyre_deflection == 0.0 < workshop.tyre_deflection
 
 
 def test_as_built_for_takes_nothing_a_profile_or_a_file(tmp_path):

@@ -99,7 +99,7 @@ def test_an_unknown_profile_is_named_with_the_known_ones():
     with pytest.raises(ConfigError) as info:
         as_built_for("nosuch:3", STD)
     assert str(info.value) == (
-        "nosuch:3: no as-built profile 'nosuch' (the profiles: field, workshop) and no file of that name"
+        "nosuch:3: no as-built profile 'nosuch' (the profiles: field, rigid, workshop) and no file of that name"
     )
 
 

@@ -2,7 +2,7 @@
 
 Why. A single yaw-rate multiplier fitted on U turns of the working radius does not say how a steered
 robot's heading drifts in spins, crab legs and the moments its wheels re-steer. Measured on an as-built
-Figure 7 robot of the ``workshop`` profile (rigid tyres up to 1.7 % apart, homing within 0.3 degrees),
+Figure 7 robot of the ``rigid`` profile (rigid tyres up to 1.7 % apart, homing within 0.3 degrees),
 its calibration's radii, offsets and yaw per metre in effect, heading error (ground truth less odometry)
 by what the robot did:
 
@@ -15,7 +15,7 @@ by what the robot did:
 The last is where the wheels disagree: each wheel's velocity read right, but no rigid motion gives
 them all. Odometry's least squares then weighs every wheel alike, while the frame moves as the wheels
 that carry it push it. On rigid tyres of unequal radii a frame of six wheels stands on three (the
-simulator measured 1291, 757 and 516 N on drives 1, 3 and 5 of ``workshop:1``, nothing on the other
+simulator measured 1291, 757 and 516 N on drives 1, 3 and 5 of ``rigid:1``, nothing on the other
 three), and the three it does not stand on turn almost free. The model::
 
     wz' = m (wz + weighted) + b vx + c vy
@@ -48,7 +48,7 @@ weights' effect is bounded (the calculator's MAX_WEIGHTED_GAIN), and so are m, b
 them is refused.
 
 What a drive cannot determine. On rigid tyres the frame does not always stand on the same wheels: in a
-U turn at 1 m/s (1.3 m/s^2 across) ``workshop:2``'s frame rocks between drives {0, 2, 3}, {0, 2, 4},
+U turn at 1 m/s (1.3 m/s^2 across) ``rigid:2``'s frame rocks between drives {0, 2, 3}, {0, 2, 4},
 {2, 5} and {2, 3, 5} within a second, and identical U turns of one drive end 1 to 2 degrees apart
 (its field route: the exits of two right U turns read -0.04 and -3.05 degrees). Which wheels it lands
 on is not in the drive states; no fixed weights, and nothing fitted from another drive, tell it.

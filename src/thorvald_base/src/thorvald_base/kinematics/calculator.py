@@ -38,7 +38,7 @@ YAW_RATE_MULTIPLIER_RANGE = (0.9, 1.1)  # a tyre slips a turn short by a few per
 MAX_YAW_PER_METRE = 0.005  # [rad/m]: 0.3 degrees a metre is a bent frame or a broken module, not calibration
 # The weighted fit may read the wheels' disagreement as a turn at most this many times as strongly as the
 # plain fit (the largest gain of any wheel's velocity on the yaw rate): a frame on three of six wheels reads
-# it about twice as strongly (workshop:1: 1.9); beyond this the weights lean on wheels too close together
+# it about twice as strongly (rigid:1: 1.9); beyond this the weights lean on wheels too close together
 # to tell a turn, and a bad fit would turn odometry wherever the wheels disagree
 MAX_WEIGHTED_GAIN = 4.0
 REALISABLE_TOLERANCE = 1e-9  # [m/s]: wheel-velocity change below which a twist counts as unchanged

@@ -81,6 +81,9 @@ class Profile:
     # [-] the tyres' loaded rolling radius below the configured one, drawn uniformly from this range
     # once per robot (one load, one pressure for all its tyres)
     loaded: Tuple[float, float] = (0.0, 0.0)
+    # [-] of the radius: the tyres' deflection under their share of the weight; None: the loaded draw's
+    # TYRE_DEFLECTION_PER_LOADED times
+    deflection: Optional[float] = None
 
 
 # A loaded pneumatic tyre's deflection is about three times the drop of its rolling radius (above): a
@@ -97,9 +100,16 @@ PROFILES: Dict[str, Profile] = {
     # 2 %), so odometry on the configured radius reads long, as the paper's (+1.0 %)
     "field": Profile(radius=0.01, steering_offset=math.radians(0.5), encoders=True, loaded=(0.01, 0.02)),
     # A robot as the workshop leaves it, before the field: only its tyres' radii (+-0.85 % each, up to
-    # 1.7 % apart: pressure and wear) and its steering's homing (+-0.3 deg) off; rigid, unloaded tyres
-    # (a six-wheeled frame then stands on the wheels its radii favour), exact encoders
-    "workshop": Profile(radius=0.0085, steering_offset=math.radians(0.3), encoders=False),
+    # 1.7 % apart: pressure and wear) and its steering's homing (+-0.3 deg) off, exact encoders. Its
+    # tyres are pneumatic as a field robot's (deflecting 4.5 % of their radius under their share of the
+    # weight, the field draw's middle), so its frame stands on every wheel; the drawn radii are the
+    # rolling ones.
+    "workshop": Profile(radius=0.0085, steering_offset=math.radians(0.3), encoders=False, deflection=0.045),
+    # The workshop's draw (the same radii and homing for a seed) on rigid tyres: a frame of more than
+    # three wheels stands on the three its radii favour, the others turning almost free, and the
+    # differential robot, lifting its lighter drive wheel in a U turn, spins on the spot for the rest of
+    # a field route. For studying what a statically indeterminate frame does to odometry.
+    "rigid": Profile(radius=0.0085, steering_offset=math.radians(0.3), encoders=False),
 }
 
 
@@ -233,7 +243,8 @@ def draw_as_built(spec: str, config: RobotConfig) -> AsBuilt:
         DriveAsBuilt(_name(i), d.r_wheel * scale * (1.0 - loaded), offset)
         for i, (d, (scale, offset)) in enumerate(zip(config.drives, draws))
     )
-    deflection = TYRE_DEFLECTION_PER_LOADED * loaded * sum(d.r_wheel for d in config.drives) / len(config.drives)
+    per_radius = TYRE_DEFLECTION_PER_LOADED * loaded if profile.deflection is None else profile.deflection
+    deflection = per_radius * sum(d.r_wheel for d in config.drives) / len(config.drives)
     return AsBuilt(spec, drives, profile.encoders, 0.0, 0.0, _radii(config), loaded, deflection)
 
 

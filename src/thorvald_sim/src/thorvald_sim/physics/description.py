@@ -45,6 +45,7 @@ class JointInfo:
     velocity: float  # [rad/s] or [m/s]; 0 when the URDF gives none
     damping: float  # [N m s/rad] or [N s/m]
     friction: float  # [N m] or [N]
+    axis: Tuple[float, float, float] = (1.0, 0.0, 0.0)  # in the joint's frame (URDF's default)
 
 
 # The robot file's keys a drive's motors are made of, with their defaults (a Thorvald module's).
@@ -106,6 +107,16 @@ def _float(text: Optional[str], what: str) -> float:
         raise DescriptionError(f"{what}: {text!r} is not a number") from None
 
 
+def _axis(element: Optional[ET.Element], joint: str) -> Tuple[float, float, float]:
+    if element is None or element.get("xyz") is None:
+        return (1.0, 0.0, 0.0)
+    values = element.get("xyz", "").split()
+    if len(values) != 3:
+        raise DescriptionError(f"joint {joint} axis: {element.get('xyz')!r} is not three numbers")
+    x, y, z = (_float(v, f"joint {joint} axis") for v in values)
+    return (x, y, z)
+
+
 def parse_description(xml: str) -> RobotDescription:
     """The simulator's view of a URDF; DescriptionError saying why it cannot be used."""
     if not xml or not xml.strip():
@@ -135,6 +146,7 @@ def description_of(root: ET.Element) -> RobotDescription:
             _float(limit.get("velocity") if limit is not None else None, f"joint {name} velocity"),
             _float(dynamics.get("damping") if dynamics is not None else None, f"joint {name} damping"),
             _float(dynamics.get("friction") if dynamics is not None else None, f"joint {name} friction"),
+            _axis(j.find("axis"), name),
         )
     springs = []
     for g in root.findall("gazebo"):

@@ -179,13 +179,17 @@ class SimRobot:
     def _soften_tyres(self, deflection: float) -> None:
         """Pneumatic tyres: each wheel's contact gives deflection [m] under its share of the robot's
         weight (a spring of that share over deflection, critically damped for the share's mass), so the
-        weight spreads over every wheel as tyres spread it. The wheel still rolls on its radius."""
+        weight spreads over every wheel as tyres spread it. The wheel still rolls on its radius. Every
+        wheel on the ground: the drives' and the passive ones (a caster's wheel, not its swivel; rigid
+        casters under a frame on soft drive tyres lifted one another as the frame rocked)."""
         c, body = self.client, self.body
         links = range(-1, p.getNumJoints(body, physicsClientId=c))
-        share = sum(p.getDynamicsInfo(body, link, physicsClientId=c)[0] for link in links) / len(self.wheels)  # [kg]
+        # a passive joint turning about an axis across its frame's z (a caster's swivel turns about z): a wheel
+        wheels = [joint for joint, _, _ in self.wheels] + [j for j, info in self.passive if abs(info.axis[2]) < 0.5]
+        share = sum(p.getDynamicsInfo(body, link, physicsClientId=c)[0] for link in links) / len(wheels)  # [kg]
         stiffness = share * GRAVITY / deflection
         damping = 2.0 * math.sqrt(stiffness * share)
-        for joint, _, _ in self.wheels:
+        for joint in wheels:
             p.changeDynamics(body, joint, contactStiffness=stiffness, contactDamping=damping, physicsClientId=c)
 
     def _setup_joints(self) -> None:
