@@ -98,7 +98,7 @@ def test_a_casters_wheel_carries_load_on_soft_tyres_too():
     with RobotSession(DIFF, RunOptions(as_built="field:4")) as s:
         s.run(2.0, lambda t: (0.0, 0.0, 0.0))
         body, c = s.robot.body, s.client
-        casters = [j for j, info in s.robot.passive if info.name.endswith("_wheel")]
+        casters = [s.robot.joint_index[j.name] for j in s.robot.description.passive_wheels]
         contacts = [p.getContactPoints(bodyA=body, linkIndexA=j, physicsClientId=c) for j in casters]
         caster_loads = [sum(point[9] for point in points) for points in contacts]  # normal forces [N]
         drives = s.robot.wheel_loads()

@@ -45,7 +45,6 @@ class JointInfo:
     velocity: float  # [rad/s] or [m/s]; 0 when the URDF gives none
     damping: float  # [N m s/rad] or [N s/m]
     friction: float  # [N m] or [N]
-    axis: Tuple[float, float, float] = (1.0, 0.0, 0.0)  # in the joint's frame (URDF's default)
 
 
 # The robot file's keys a drive's motors are made of, with their defaults (a Thorvald module's).
@@ -99,22 +98,18 @@ class RobotDescription:
             j for j in self.joints.values() if j.type != "fixed" and j.name not in driven and j.name not in sprung
         )
 
+    @property
+    def passive_wheels(self) -> Tuple[JointInfo, ...]:
+        """The passive joints that are wheels on the ground (the generator's ``passiveN_wheel``; a caster's
+        ``passiveN_swivel`` is not): their tyres are narrowed and, on soft tyres, softened as a drive's."""
+        return tuple(j for j in self.passive_joints if j.name.endswith("wheel"))
+
 
 def _float(text: Optional[str], what: str) -> float:
     try:
         return float(text) if text not in (None, "") else 0.0
     except ValueError:
         raise DescriptionError(f"{what}: {text!r} is not a number") from None
-
-
-def _axis(element: Optional[ET.Element], joint: str) -> Tuple[float, float, float]:
-    if element is None or element.get("xyz") is None:
-        return (1.0, 0.0, 0.0)
-    values = element.get("xyz", "").split()
-    if len(values) != 3:
-        raise DescriptionError(f"joint {joint} axis: {element.get('xyz')!r} is not three numbers")
-    x, y, z = (_float(v, f"joint {joint} axis") for v in values)
-    return (x, y, z)
 
 
 def parse_description(xml: str) -> RobotDescription:
@@ -146,7 +141,6 @@ def description_of(root: ET.Element) -> RobotDescription:
             _float(limit.get("velocity") if limit is not None else None, f"joint {name} velocity"),
             _float(dynamics.get("damping") if dynamics is not None else None, f"joint {name} damping"),
             _float(dynamics.get("friction") if dynamics is not None else None, f"joint {name} friction"),
-            _axis(j.find("axis"), name),
         )
     springs = []
     for g in root.findall("gazebo"):

@@ -138,7 +138,7 @@ class SimRobot:
         self.sensor_blocks = None  # thorvald_sim.sensors.blocks.SensorBlocks: also what is not simulated
         self.sensor_problems = []  # sensors that could not be mounted
         wheels = [d.wheel_joint for d in description.drives]
-        wheels += [j.name for j in description.passive_joints if j.name.endswith("wheel")]
+        wheels += [j.name for j in description.passive_wheels]
         radii = {
             d.wheel_joint: b.r_wheel for d, b in zip(description.drives, self.built) if b.r_wheel != d.wheel_radius
         }
@@ -184,8 +184,8 @@ class SimRobot:
         casters under a frame on soft drive tyres lifted one another as the frame rocked)."""
         c, body = self.client, self.body
         links = range(-1, p.getNumJoints(body, physicsClientId=c))
-        # a passive joint turning about an axis across its frame's z (a caster's swivel turns about z): a wheel
-        wheels = [joint for joint, _, _ in self.wheels] + [j for j, info in self.passive if abs(info.axis[2]) < 0.5]
+        passive = [self.joint_index[j.name] for j in self.description.passive_wheels if j.name in self.joint_index]
+        wheels = [joint for joint, _, _ in self.wheels] + passive
         share = sum(p.getDynamicsInfo(body, link, physicsClientId=c)[0] for link in links) / len(wheels)  # [kg]
         stiffness = share * GRAVITY / deflection
         damping = 2.0 * math.sqrt(stiffness * share)
