@@ -7,7 +7,7 @@ import pytest
 
 from thorvald_sim.errors import ParameterError, ThorvaldSimError
 from thorvald_sim.node.commands import APPLY, HOLD, STREAM_ALIVE, CommandSlot
-from thorvald_sim.node.lockstep import Lockstep
+from thorvald_sim.node.lockstep import STARTUP_SPAN, STARTUP_TIMEOUT, Lockstep
 from thorvald_sim.node.pacing import FollowerWait, Pacer
 from thorvald_sim.node.params import SimulatorParams
 
@@ -119,19 +119,61 @@ def test_an_older_command_does_not_answer_a_newer_instant():
 
 def test_a_robot_that_never_answers_is_released_after_its_timeout_and_the_others_go_on():
     steps, clock = lockstep(timeout=2.0)
-    steps.published("silent", 0.1)
-    steps.published("r2", 0.1)
-    steps.answered("r2", 0.1)
+    for name in ("silent", "r2"):
+        steps.published(name, 0.0125)  # joined at the start
+        steps.answered(name, 0.0125)
+    steps.published("silent", 1.1)  # past its first second in lockstep
+    steps.published("r2", 1.1)
+    steps.answered("r2", 1.1)
     assert steps.wait() == ["silent"]
     assert clock.now - 100.0 == pytest.approx(2.0)
     # let go: the world no longer waits for it, while r2 is still awaited each instant
-    steps.published("silent", 0.2)
-    steps.published("r2", 0.2)
+    steps.published("silent", 1.2)
+    steps.published("r2", 1.2)
     assert steps.waiting() == ["r2"]
     # its next command brings it back
-    assert steps.answered("silent", 0.2)
-    steps.published("silent", 0.3)
+    assert steps.answered("silent", 1.2)
+    steps.published("silent", 1.3)
     assert "silent" in steps.waiting()
+
+
+def test_a_robot_in_its_first_second_in_lockstep_has_the_startup_timeout():
+    """A driver just started answers its first instants while its process still imports and connects:
+    it has STARTUP_TIMEOUT for those of its first STARTUP_SPAN of simulated time, then TIMEOUT; one that
+    joins again later starts a span of its own."""
+    steps, clock = lockstep(timeout=2.0)
+    steps.published("old", 0.0125)
+    steps.answered("old", 0.0125)
+    steps.published("old", 1.5)  # an instant after its first second: 2 s
+    steps.published("new", 1.5)  # joins here: 10 s
+    assert steps.allowed("old") == 2.0 and steps.allowed("new") == STARTUP_TIMEOUT
+    assert steps.wait() == ["old", "new"]  # both silent: old let go at 2 s, new at 10 s
+    assert clock.now - 100.0 == pytest.approx(STARTUP_TIMEOUT)
+    steps.answered("new", 1.5)
+    steps.published("new", 1.5 + STARTUP_SPAN)  # its span over
+    assert steps.allowed("new") == 2.0
+    assert steps.answered("old", 2.6)  # joins again: a span of its own
+    steps.published("old", 2.6)
+    assert steps.allowed("old") == STARTUP_TIMEOUT
+
+
+def test_the_others_are_let_go_at_their_own_timeouts():
+    steps, clock = lockstep(timeout=2.0)
+    steps.published("old", 0.0125)
+    steps.answered("old", 0.0125)
+    steps.published("old", 1.5)
+    steps.published("new", 1.5)
+    # the new one answers after 5 s: the old one was let go at 2 s, the wait ends with the answer
+    original = steps._wait
+
+    def wait(condition, seconds):
+        original(condition, seconds)
+        if clock.now - 100.0 >= 5.0 and steps.waiting() == ["new"]:
+            steps.answered("new", 1.5)
+
+    steps._wait = wait
+    assert steps.wait() == ["old"]
+    assert clock.now - 100.0 == pytest.approx(5.0, abs=0.11)
 
 
 def test_a_wait_ends_when_the_answer_comes_from_another_thread():
