@@ -2,8 +2,7 @@
 tyres): a frame of more than three wheels stands on all of them, as it does on pneumatic tyres, where
 rigid tyres of radii a millimetre apart left it on two."""
 
-import math
-
+import numpy as np
 import pytest
 
 from thorvald_base.verification import plan_named
@@ -74,12 +73,8 @@ def turned_on_the_field_route(as_built: str):
     config = load_robot_config(DIFF)
     commands = commands_from_plan(plan_named("field", config)[1], start=0.5)
     run = run_robot(DIFF, commands, RunOptions(world="tarmac_gravel", as_built=as_built))
-    turned, last = [0.0], 0.0
-    for sample in run.ground_truth:
-        step = (sample.yaw - last + math.pi) % (2.0 * math.pi) - math.pi
-        turned.append(turned[-1] + step)
-        last = sample.yaw
-    return max(abs(math.degrees(t)) for t in turned), math.degrees(turned[-1])
+    turned = np.degrees(np.unwrap([0.0] + [sample.yaw for sample in run.ground_truth]))
+    return float(np.max(np.abs(turned))), float(turned[-1])
 
 
 @pytest.mark.slow  # pybullet: a simulation, or worlds and robots built in it

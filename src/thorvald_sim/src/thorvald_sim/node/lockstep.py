@@ -102,9 +102,11 @@ class Lockstep:
     def allowed(self, name: str) -> float:
         """[s] of wall time robot name may leave its awaited instant unanswered."""
         with self.condition:
-            robot = self._robot(name)
-            starting = robot.awaiting is not None and robot.awaiting - robot.since < STARTUP_SPAN
-            return self.startup_timeout if starting else self.timeout
+            return self._allowed(self._robot(name))
+
+    def _allowed(self, robot: _Robot) -> float:
+        starting = robot.awaiting is not None and robot.awaiting - robot.since < STARTUP_SPAN
+        return self.startup_timeout if starting else self.timeout
 
     def wait(self, stop: Callable[[], bool] = lambda: False) -> List[str]:
         """Holds until every robot in lockstep answered its last instant, each at most its allowed wall
@@ -114,17 +116,19 @@ class Lockstep:
         let_go: List[str] = []
         with self.condition:
             while not stop():
-                waiting = [n for n, r in self._robots.items() if r.in_lockstep and r.awaiting is not None]
-                if not waiting:
+                allowed = {
+                    n: self._allowed(r) for n, r in self._robots.items() if r.in_lockstep and r.awaiting is not None
+                }
+                if not allowed:
                     return let_go
                 waited = self.clock() - started
-                late = [n for n in waiting if waited >= self.allowed(n)]
+                late = [n for n, seconds in allowed.items() if waited >= seconds]
                 for name in late:
                     robot = self._robots[name]
                     robot.in_lockstep, robot.awaiting = False, None
                 let_go += late
-                if len(late) == len(waiting):
+                if len(late) == len(allowed):
                     return let_go
-                left = min(self.allowed(n) for n in waiting if n not in late) - waited
+                left = min(seconds for n, seconds in allowed.items() if n not in late) - waited
                 self._wait(self.condition, min(left, POLL))
         return let_go
