@@ -405,6 +405,7 @@ def heading_json(fit: HeadingFit, said: str, errors, path: str) -> dict:
         "in_effect": list(fit.in_effect.wheel_weights),
     }
     out["yaw_per_metre"]["kept"] = fit.kept_yaw_per_metre
+    out["yaw_rate_multiplier"]["whole_turns"] = len(fit.turns)  # 0: from the windows, or kept
     out["heading_rms_deg"] = {"before": math.degrees(fit.rms_before), "after": math.degrees(fit.rms_after)}
     out["motions"] = [
         {

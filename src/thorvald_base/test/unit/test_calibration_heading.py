@@ -346,6 +346,38 @@ def test_weights_that_fit_each_window_but_leave_more_heading_in_all_are_refused(
     assert fit.correction.yaw_rate_multiplier == pytest.approx(1.0, abs=0.005)  # nothing else to take up
 
 
+def headland_drive(rocking: float):
+    """A differential robot's rows at 1 m/s and U turns at 1.2 rad/s for 2.6 s, both ways, 23 of them in
+    240 s; ground truth turns 2 % more than the wheels say, and its frame rocks by ``rocking`` rad at 0.83 Hz
+    (what scatters a real robot's windows: the frame lagging and catching up): (config, recording, truth)."""
+    config = robot_config("thorvald_ii_2wd_diff.yaml")
+    calc = load_calculator(config)
+    t = 50.0 + np.arange(int(240 * RATE)) / RATE
+    wz = np.zeros_like(t)
+    for k, start in enumerate(np.arange(55.0, 285.0, 10.0)):
+        wz[(t >= start) & (t < start + 2.6)] = 1.2 * (-1) ** k
+    speed = np.stack([1.0 - wz * y for y in calc.layout.y], axis=1)
+    recording = DriveRecording(t, np.zeros_like(speed), speed)
+    yaw = 0.3 + np.cumsum(1.02 * wz / RATE) + rocking * np.sin(2 * np.pi * 0.83 * t)
+    zero = np.zeros_like(t)
+    return config, recording, PoseTruth(t, zero, zero, yaw, zero, zero, zero)
+
+
+@pytest.mark.slow  # two fits over four minutes of samples
+def test_where_the_windows_scatter_the_multiplier_comes_from_whole_turns():
+    # rocking by 0.06 rad: the 0.5 s windows leave m within two of their uncertainty of 1, the 23 U turns,
+    # each read whole, tell it; rocking by 0.03 the windows tell it themselves
+    config, recording, truth = headland_drive(0.06)
+    fit = heading_fit(config, [(recording, truth)])
+    m, sd = fit.correction.yaw_rate_multiplier, fit.sd[0]
+    assert len(fit.turns) == 23 and fit.excited[0] and not fit.undetermined[0]
+    assert abs(m - 1.02) < 2.5 * sd < 0.01
+    assert "from 23 whole turns: the windows' scatter left it within 2 sd" in "\n".join(describe(fit))
+    config, recording, truth = headland_drive(0.03)
+    fit = heading_fit(config, [(recording, truth)])
+    assert fit.turns == () and fit.excited[0] and abs(fit.correction.yaw_rate_multiplier - 1.02) < 2.5 * fit.sd[0]
+
+
 @pytest.mark.slow  # a fit over a minute of samples
 def test_a_fit_beyond_a_calibration_or_a_drive_too_short_is_refused(square):
     recording, calc = drawn_drive(square, seconds=60.0, disagree=0.0)

@@ -35,7 +35,12 @@ Levenberg–Marquardt with priors at the values in effect: weak for m, b and c (
 not excite, c on a robot that cannot crab, stays where it was), and on the weights all alike with
 LOG_WEIGHT_SD. One of m, b and c that the drive moves by less than DETERMINED standard uncertainties from
 its value in effect stays there too, and the rest are fitted again without it (the heading drive's 8 m
-of crab legs gave c from 0.0011 +- 0.002 to -0.0015 +- 0.010 rad/m on seed 4's robots). The weights are
+of crab legs gave c from 0.0011 +- 0.002 to -0.0015 +- 0.010 rad/m on seed 4's robots). An m the windows
+leave so comes from the drives' whole turns instead (turns.py: each turn from a second before it to a
+second after, read with the rest of the model in effect), where they tell it (scattered by at most
+MAX_GAIN_SD, moved by DETERMINED of that): a frame that lags its wheels into a turn and catches up after it
+scatters each window by a degree or more and leaves the whole turn alone (the differential robot's heading
+drive: windows 1.0048 +- 0.0042, its 18 turns 1.0150 +- 0.0038). The weights are
 used only where they take WEIGHTS_TOLD of the windows' squared error off
 (a differential robot's two wheels never disagree; a frame on soft tyres may stand on all its wheels
 alike) and leave less heading error in all over the windows where the wheels disagree than the fit
@@ -65,10 +70,18 @@ import numpy as np
 from thorvald_model.values import RobotConfig
 
 from ..errors import CalibrationError, KinematicsError
-from ..kinematics.calculator import MAX_ODOMETRY_DT, NO_CORRECTION, OdometryCorrection, weighted_yaw_gains
+from ..kinematics.calculator import (
+    MAX_ODOMETRY_DT,
+    NO_CORRECTION,
+    YAW_RATE_MULTIPLIER_RANGE,
+    OdometryCorrection,
+    weighted_yaw_gains,
+)
 from ..plugins import load_calculator
 from .estimate import MOVING
 from .recording import DriveRecording, GnssTruth, PoseTruth
+from .through_origin import through_origin
+from .turns import MAX_GAIN_SD, MIN_TURNS, Turn, drive_turns
 
 WINDOW = 0.5  # [s]: short enough that a re-steering's second stands apart from the turn around it
 IMU_AVERAGE = 0.05  # [s] either side: the IMU's yaw averaged over 11 samples at 100 Hz at each end
@@ -118,6 +131,7 @@ class HeadingFit:
     kept_yaw_per_metre: bool = False  # b kept as in effect (the straight legs'), not fitted
     weights_said: str = ""  # why the weights were kept as in effect, if they were
     undetermined: Tuple[bool, bool, bool] = (False, False, False)  # m, b, c: moved less than DETERMINED sd: kept
+    turns: Tuple[Turn, ...] = ()  # the whole turns m came from where the windows left it undetermined (else ())
 
 
 @dataclass(frozen=True)
@@ -224,9 +238,18 @@ def heading_fit(
         told &= ~undetermined
     in_effect_linear = (in_effect.yaw_rate_multiplier, in_effect.yaw_per_metre, in_effect.yaw_per_metre_sideways)
     linear = [float(p[k]) if told[k] else in_effect_linear[k] for k in range(3)]
-    sd = tuple(float(v) for v in sd)
     weights = np.exp(p[3:] - np.max(p[3:]))
     correction = OdometryCorrection(*linear, _mean_one(weights) if weights_told else in_effect.wheel_weights)
+    turns: Tuple[Turn, ...] = ()
+    if not told[0]:
+        # the windows leave m as in effect: the drives' whole turns, the rest of the model in effect, may tell it
+        turns, gain, gain_sd = _whole_turns(config, drives, correction, calculator_for)
+        if turns:
+            linear[0] *= gain
+            sd[0] = correction.yaw_rate_multiplier * gain_sd
+            told[0], undetermined[0] = True, False
+            correction = OdometryCorrection(*linear, correction.wheel_weights)
+    sd = tuple(float(v) for v in sd)
     problems = correction.problems()
     if problems:
         raise CalibrationError(
@@ -251,7 +274,26 @@ def heading_fit(
         keep_yaw_per_metre,
         said,
         (bool(undetermined[0]), bool(undetermined[1]), bool(undetermined[2])),
+        turns,
     )
+
+
+def _whole_turns(config: RobotConfig, drives: Sequence[Drive], correction: OdometryCorrection, calculator_for):
+    """(turns, gain, its sd): the drives' whole turns (turns.py) replayed with correction, and the gain on
+    its multiplier that makes them read as ground truth turned them; () when they do not determine one
+    (fewer than MIN_TURNS, scattered beyond MAX_GAIN_SD, within DETERMINED sd of 1, or the multiplier out
+    of range)."""
+    turns = tuple(turn for recording, truth in drives for turn in drive_turns(config, recording, truth, correction,
+                                                                               calculator_for))  # fmt: skip
+    if len(turns) < MIN_TURNS:
+        return (), 1.0, math.nan
+    gain, gain_sd = through_origin([turn.odometry for turn in turns], [turn.truth for turn in turns])
+    low, high = YAW_RATE_MULTIPLIER_RANGE
+    if not gain_sd <= MAX_GAIN_SD or abs(gain - 1.0) < DETERMINED * gain_sd:
+        return (), 1.0, math.nan
+    if not low <= correction.yaw_rate_multiplier * gain <= high:
+        return (), 1.0, math.nan
+    return turns, gain, gain_sd
 
 
 def _cost(r: np.ndarray) -> float:
@@ -447,6 +489,11 @@ def describe(fit: HeadingFit) -> List[str]:
     def told(k: int) -> str:
         if k == 1 and fit.kept_yaw_per_metre:
             return "(kept: the straight legs')"
+        if k == 0 and fit.turns:
+            return (
+                f"± {fit.sd[0]:.2g} (from {len(fit.turns)} whole turns: the windows' scatter left it within "
+                f"{DETERMINED:g} sd of the value in effect)"
+            )
         if fit.undetermined[k]:
             return f"(not determined: within {DETERMINED:g} of its ± {fit.sd[k]:.2g} of the value in effect, kept)"
         return f"± {fit.sd[k]:.2g}" if fit.excited[k] else "(not excited: kept)"

@@ -95,6 +95,27 @@ def turn_windows(t: np.ndarray, yaw: np.ndarray) -> Tuple[Tuple[float, float], .
     return tuple(windows)
 
 
+def drive_turns(
+    config: RobotConfig,
+    recording: DriveRecording,
+    truth: Union[PoseTruth, GnssTruth],
+    in_effect: OdometryCorrection = NO_CORRECTION,
+    calculator_for: Callable = load_calculator,
+) -> Tuple[Turn, ...]:
+    """The drive's turns (:func:`turn_windows` of odometry replayed with in_effect, within ground truth),
+    each with the heading ground truth and odometry turned by."""
+    t, _, _, yaw = replay(config, recording, calculator_for, correction=in_effect)
+    lo, hi = (truth.t[0], truth.t[-1]) if isinstance(truth, PoseTruth) else (truth.t_yaw[0], truth.t_yaw[-1])
+    inside = (t >= lo) & (t <= hi)
+    t, yaw = t[inside], yaw[inside]
+    turns = []
+    for start, end in turn_windows(t, yaw):
+        ends = np.array([start, end])
+        odometry = float(np.diff(np.interp(ends, t, yaw))[0])
+        turns.append(Turn(float(start), float(end), float(np.diff(truth_yaw(truth, ends))[0]), odometry))
+    return tuple(turns)
+
+
 def turn_fit(
     config: RobotConfig,
     recording: DriveRecording,
@@ -105,15 +126,7 @@ def turn_fit(
     """The yaw-rate multiplier that makes the drive's turns read as ground truth turned them.
     CalibrationError if the drive holds fewer than MIN_TURNS turns, or the multiplier comes out
     beyond what slip explains."""
-    t, _, _, yaw = replay(config, recording, calculator_for, correction=in_effect)
-    lo, hi = (truth.t[0], truth.t[-1]) if isinstance(truth, PoseTruth) else (truth.t_yaw[0], truth.t_yaw[-1])
-    inside = (t >= lo) & (t <= hi)
-    t, yaw = t[inside], yaw[inside]
-    turns = []
-    for start, end in turn_windows(t, yaw):
-        ends = np.array([start, end])
-        odometry = float(np.diff(np.interp(ends, t, yaw))[0])
-        turns.append(Turn(float(start), float(end), float(np.diff(truth_yaw(truth, ends))[0]), odometry))
+    turns = drive_turns(config, recording, truth, in_effect, calculator_for)
     if len(turns) < MIN_TURNS:
         raise CalibrationError(
             f"--fit turns: the drive holds {len(turns)} turns (the odometry turning faster than {TURNING:g} rad/s for "
@@ -147,6 +160,7 @@ __all__ = [
     "TURNING",
     "Turn",
     "TurnFit",
+    "drive_turns",
     "truth_yaw",
     "turn_fit",
     "turn_windows",
