@@ -174,12 +174,14 @@ def test_the_calibration_drive_calibrates_an_as_built_robot_from_what_it_determi
         f"applied build/calibration_drive/calibration.yaml: each drive's radius and steering offset from the "
         f"calibration drive ({determined} of 12 combinations determined; the other {12 - determined} from the balance"
     ) in demo
-    # and what the heading drive determined, and what it kept (the multiplier within two of its
-    # uncertainties of 1, the weights refused: on field:3 none of the heading model is determined)
+    # and what the heading drive determined (the multiplier from the windows, or from whole turns where
+    # the windows left it within two of its uncertainties of 1), and what it kept
     said = "odometry's heading model from a drive of every motion (determined: "
     line = next(line for line in demo.splitlines() if said in line)
     if model["yaw_rate_multiplier"]["excited"]:
         assert f"the yaw-rate multiplier {multiplier:.5f}" in line
+        turns = model["yaw_rate_multiplier"]["whole_turns"]
+        assert (f"{multiplier:.5f} (from {turns} whole turns)" in line) == (turns > 0)
     else:
         assert "not determined: the yaw-rate multiplier (kept at 1)" in line
     assert ("each wheel's weight in the yaw rate" in line) == model["wheel_weights"]["told"]
