@@ -19,7 +19,7 @@ from calibration_test_helpers import MIXED, synthetic_drive
 
 from thorvald_base.calibration import DriveRecording, GnssTruth, PoseTruth
 from thorvald_base.calibration.calibration_file import changes_yaml, parse_calibration_values, read_calibration
-from thorvald_base.calibration.heading import MOTIONS, WINDOW, describe, heading_fit
+from thorvald_base.calibration.heading import HALF_BLOCK, MOTIONS, WINDOW, describe, heading_fit
 from thorvald_base.calibration.odometry_error import imu_bias
 from thorvald_base.errors import CalibrationError, KinematicsError
 from thorvald_base.kinematics import DriveState, OdometryCorrection
@@ -344,6 +344,33 @@ def test_weights_that_fit_each_window_but_leave_more_heading_in_all_are_refused(
     free, kept = (float(v) for v in re.findall(r"([0-9.]+) against ([0-9.]+) degrees without them", said)[0])
     assert free > kept
     assert fit.correction.yaw_rate_multiplier == pytest.approx(1.0, abs=0.005)  # nothing else to take up
+
+
+@pytest.mark.slow  # three fits over two minutes of samples
+def test_weights_the_drive_does_not_tell_twice_are_refused(square):
+    """The weights are used only where each half of the drive (its windows in alternate blocks of 10 s)
+    tells weights that leave less heading where the wheels disagree on the other half. A frame that stands
+    on the diagonal pair in the even blocks and on all four wheels alike in the odd ones: the whole drive
+    tells weights, but those of the odd half are none, and the even half's leave more heading on the odd
+    half's re-steering windows than weights alike; a frame on the pair throughout is told twice."""
+    recording, calc = drawn_drive(square, seed=1, disagree=0.05)
+    odd = np.floor((recording.t - recording.t[0]) / HALF_BLOCK).astype(int) % 2 == 1
+
+    def truth(weights_odd):
+        rates = {}
+        for name, weights in (("even", PAIR), ("odd", weights_odd)):
+            calc.odometry_correction = OdometryCorrection(1.0, 0.0, 0.0, weights)
+            rates[name] = np.array([calc.body_twist(a, v).wz for a, v in zip(recording.steering, recording.speed)])
+        rate = np.where(odd, rates["odd"], rates["even"])
+        yaw = np.cumsum(rate * np.diff(recording.t, prepend=recording.t[0]))
+        zero = np.zeros_like(yaw)
+        return PoseTruth(recording.t, zero, zero, yaw, zero, zero, rate)
+
+    fit = heading_fit(square, [(recording, truth((1.0, 1.0, 1.0, 1.0)))])
+    assert not fit.weights_told and fit.correction.wheel_weights == ()
+    assert fit.weights_said.startswith("not told twice: fitted on half the drive (alternate 10 s), they leave more")
+    fit = heading_fit(square, [(recording, truth(PAIR))])
+    assert fit.weights_told and fit.correction.wheel_weights == pytest.approx(PAIR, abs=0.1)
 
 
 def headland_drive(rocking: float):

@@ -41,16 +41,19 @@ second after, read with the rest of the model in effect), where they tell it (sc
 MAX_GAIN_SD, moved by DETERMINED of that): a frame that lags its wheels into a turn and catches up after it
 scatters each window by a degree or more and leaves the whole turn alone (the differential robot's heading
 drive: windows 1.0048 +- 0.0042, its 18 turns 1.0150 +- 0.0038). The weights are
-used only where they take WEIGHTS_TOLD of the windows' squared error off
-(a differential robot's two wheels never disagree; a frame on soft tyres may stand on all its wheels
-alike) and leave less heading error in all over the windows where the wheels disagree than the fit
-without them (fitting each window's shape better can still add up worse), and returned with the mean
-1. ``keep_yaw_per_metre`` keeps b as in effect: straight legs at working speed between standstills
-(``--fit straight``) tell it ten times as precisely (0.005 against 0.05 degrees a metre), and a drive
-of every motion otherwise lets the re-steering windows pull it (on
-``field:3`` from 0.0021 to 0.0032 rad/m, and the field route's end point from 0.24 to 0.72 m). The
-weights' effect is bounded (the calculator's MAX_WEIGHTED_GAIN), and so are m, b and c: a fit beyond
-them is refused.
+used only where they take WEIGHTS_TOLD of the windows' squared error off (a differential robot's two
+wheels never disagree; a frame on soft tyres may stand on all its wheels alike) and leave less heading
+error in all over the windows where the wheels disagree than the fit without them (fitting each window's
+shape better can still add up worse), and where the drive tells them twice: fitted on either half of its
+windows (alternate blocks of HALF_BLOCK), they must leave less heading where the wheels disagree on the
+other half than the weights in effect (two runs of one bench gave the Figure 7 robot on ``field:4`` the
+weights 0.59 3.55 0.40 1.25 0.09 0.12 and 0.00 4.72 0.62 0.62 0.00 0.04, and its paper-like drive ended
+0.49 and 1.67 m off: weights fitted to one drive's rocking); they are returned with the mean 1.
+``keep_yaw_per_metre`` keeps b as in effect: straight legs at working speed between standstills (``--fit
+straight``) tell it ten times as precisely (0.005 against 0.05 degrees a metre), and a drive of every
+motion otherwise lets the re-steering windows pull it (on ``field:3`` from 0.0021 to 0.0032 rad/m, and
+the field route's end point from 0.24 to 0.72 m). The weights' effect is bounded (the calculator's
+MAX_WEIGHTED_GAIN), and so are m, b and c: a fit beyond them is refused.
 
 What a drive cannot determine. On rigid tyres the frame does not always stand on the same wheels: in a
 U turn at 1 m/s (1.3 m/s^2 across) ``rigid:2``'s frame rocks between drives {0, 2, 3}, {0, 2, 4},
@@ -63,7 +66,7 @@ Pure: numpy, no rospy.
 
 import math
 from dataclasses import dataclass
-from typing import Callable, List, Sequence, Tuple, Union
+from typing import Callable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -94,6 +97,7 @@ LINEAR_SD = 10.0  # m, b [rad/m] and c [rad/m]: a prior so weak that only an une
 KEPT_SD = 1e-9  # [rad/m]: b kept as in effect
 MIN_WINDOWS = 20
 DETERMINED = 2.0  # standard uncertainties a fitted m, b or c must move from the value in effect to be used
+HALF_BLOCK = 10.0  # [s]: the drive's windows in alternate blocks of this make the two halves the weights must agree on
 WEIGHTS_TOLD = 0.05  # of the windows' squared heading error the weights must take off to be used
 MAX_ITERATIONS = 60
 CONVERGED = 1e-10
@@ -183,11 +187,14 @@ def heading_fit(
     windows = len(drive.truth)
     resteering = np.array([motion_of(drive, a, z) == "re-steering" for a, z in drive.bounds], dtype=bool)
 
-    def fit_with(scale: np.ndarray):
-        """(p, weights_told, said, sd of m, b and c, told) with the priors' scale."""
+    def fit_with(scale: np.ndarray, pick: Optional[np.ndarray] = None):
+        """(p, weights_told, said, sd of m, b and c, told) with the priors' scale, over the windows picked
+        (default: all)."""
+        pick = np.ones(windows, dtype=bool) if pick is None else pick
+        count = int(np.sum(pick))
 
         def residuals(p: np.ndarray) -> np.ndarray:
-            return np.concatenate([drive.truth - windows_of(p), PRIOR_ROW * (p - prior) / scale])
+            return np.concatenate([(drive.truth - windows_of(p))[pick], PRIOR_ROW * (p - prior) / scale])
 
         # the weights kept as in effect first (m, b and c enter linearly), then free: the weights are told
         # where they take WEIGHTS_TOLD of the windows' squared error off (a frame that stands on all its
@@ -195,13 +202,13 @@ def heading_fit(
         kept = prior[3:]
         linear = _solve(lambda q: residuals(np.concatenate([q, kept])), prior[:3].copy())
         p = _solve(residuals, np.concatenate([linear, kept]))
-        cost_kept = _cost(residuals(np.concatenate([linear, kept]))[:windows])
-        weights_told = cost_kept - _cost(residuals(p)[:windows]) > WEIGHTS_TOLD * cost_kept
+        cost_kept = _cost(residuals(np.concatenate([linear, kept]))[:count])
+        weights_told = cost_kept - _cost(residuals(p)[:count]) > WEIGHTS_TOLD * cost_kept
         # the weights act where the wheels disagree: they must also leave less heading there in all, not
         # only fit each window's shape better (on field:3 the windows' squared error fell by half while
         # the re-steering windows' sum went from +4 to +8 degrees)
-        sum_kept = abs(float(np.sum((drive.truth - windows_of(np.concatenate([linear, kept])))[resteering])))
-        sum_free = abs(float(np.sum((drive.truth - windows_of(p))[resteering])))
+        sum_kept = abs(float(np.sum((drive.truth - windows_of(np.concatenate([linear, kept])))[resteering & pick])))
+        sum_free = abs(float(np.sum((drive.truth - windows_of(p))[resteering & pick])))
         said = "" if weights_told else "not told apart: the wheels never disagreed, or alike fit as well"
         if weights_told and sum_free > sum_kept:
             weights_told = False
@@ -213,8 +220,8 @@ def heading_fit(
             p = np.concatenate([linear, kept])
         r = residuals(p)
         jac = _jacobian(residuals, p, r)[:, :3]
-        data = jac[:windows]
-        sigma2 = float(r[:windows] @ r[:windows]) / max(1, windows - 3)
+        data = jac[:count]
+        sigma2 = float(r[:count] @ r[:count]) / max(1, count - 3)
         try:
             cov = sigma2 * np.linalg.inv(jac.T @ jac)
             sd = np.array([math.sqrt(max(cov[k, k], 0.0)) for k in range(3)])
@@ -226,6 +233,15 @@ def heading_fit(
 
     scale = np.array([LINEAR_SD, KEPT_SD if keep_yaw_per_metre else LINEAR_SD, LINEAR_SD] + [LOG_WEIGHT_SD] * n)
     p, weights_told, said, sd, told = fit_with(scale)
+    refused = (
+        _told_twice(fit_with, scale, p, prior[3:], windows_of=windows_of, truth=drive.truth, resteering=resteering)
+        if weights_told
+        else ""
+    )
+    if refused:  # the weights stay as in effect from here on
+        scale[3:] = KEPT_SD
+        p, weights_told, said, sd, told = fit_with(scale)
+        weights_told, said = False, refused
     told[1] = told[1] and not keep_yaw_per_metre
     # determined: the drive moves m, b or c from the value in effect by more than DETERMINED of its
     # standard uncertainty; one it does not (c from the heading drive's 8 m of crab legs: 0.0011 +- 0.002
@@ -233,7 +249,8 @@ def heading_fit(
     undetermined = told & (np.abs(p[:3] - prior[:3]) < DETERMINED * sd)
     if np.any(undetermined):
         scale[:3][undetermined] = KEPT_SD
-        p, weights_told, said, sd_again, _ = fit_with(scale)
+        p, weights_told, said_again, sd_again, _ = fit_with(scale)
+        said = refused or said_again
         sd = np.where(undetermined, sd, sd_again)
         told &= ~undetermined
     in_effect_linear = (in_effect.yaw_rate_multiplier, in_effect.yaw_per_metre, in_effect.yaw_per_metre_sideways)
@@ -278,11 +295,34 @@ def heading_fit(
     )
 
 
+def _told_twice(fit_with, scale, p, kept, *, windows_of, truth, resteering) -> str:
+    """ "" when the weights the whole drive told are told twice: fitted on each half of its windows (alternate
+    blocks of HALF_BLOCK), they leave less heading where the wheels disagree on the other half than the
+    weights in effect do, the rest of the model as the whole drive fitted it; else why not."""
+    block = np.arange(len(truth)) // max(1, round(HALF_BLOCK / WINDOW)) % 2 == 0
+    for half in (block, ~block):
+        fitted, told, said, _, _ = fit_with(scale, half)
+        if not told:
+            return f"not told twice: on half the drive (alternate {HALF_BLOCK:g} s) {said}"
+        other = resteering & ~half
+        with_them = abs(float(np.sum((truth - windows_of(np.concatenate([p[:3], fitted[3:]])))[other])))
+        without = abs(float(np.sum((truth - windows_of(np.concatenate([p[:3], kept])))[other])))
+        if with_them > without:
+            return (
+                f"not told twice: fitted on half the drive (alternate {HALF_BLOCK:g} s), they leave more heading "
+                f"where the wheels disagree on the other half ({math.degrees(with_them):.1f} against "
+                f"{math.degrees(without):.1f} degrees without them)"
+            )
+    return ""
+
+
 def _whole_turns(config: RobotConfig, drives: Sequence[Drive], correction: OdometryCorrection, calculator_for):
     """(turns, gain, its sd): the drives' whole turns (turns.py) replayed with correction, and the gain on
     its multiplier that makes them read as ground truth turned them; () when they do not determine one
     (fewer than MIN_TURNS, scattered beyond MAX_GAIN_SD, within DETERMINED sd of 1, or the multiplier out
     of range)."""
+    if correction.problems():  # heading_fit says so
+        return (), 1.0, math.nan
     turns = tuple(turn for recording, truth in drives for turn in drive_turns(config, recording, truth, correction,
                                                                                calculator_for))  # fmt: skip
     if len(turns) < MIN_TURNS:
