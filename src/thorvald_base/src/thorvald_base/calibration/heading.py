@@ -296,9 +296,9 @@ def heading_fit(
 
 
 def _told_twice(fit_with, scale, p, kept, *, windows_of, truth, resteering) -> str:
-    """ "" when the weights the whole drive told are told twice: fitted on each half of its windows (alternate
-    blocks of HALF_BLOCK), they leave less heading where the wheels disagree on the other half than the
-    weights in effect do, the rest of the model as the whole drive fitted it; else why not."""
+    """Why the weights the whole drive told are not told twice, or "" when they are: fitted on each half of
+    its windows (alternate blocks of HALF_BLOCK), they leave less heading where the wheels disagree on the
+    other half than the weights in effect do, the rest of the model as the whole drive fitted it."""
     block = np.arange(len(truth)) // max(1, round(HALF_BLOCK / WINDOW)) % 2 == 0
     for half in (block, ~block):
         fitted, told, said, _, _ = fit_with(scale, half)
@@ -323,8 +323,9 @@ def _whole_turns(config: RobotConfig, drives: Sequence[Drive], correction: Odome
     of range)."""
     if correction.problems():  # heading_fit says so
         return (), 1.0, math.nan
-    turns = tuple(turn for recording, truth in drives for turn in drive_turns(config, recording, truth, correction,
-                                                                               calculator_for))  # fmt: skip
+    turns: Tuple[Turn, ...] = ()
+    for recording, truth in drives:
+        turns += drive_turns(config, recording, truth, correction, calculator_for)
     if len(turns) < MIN_TURNS:
         return (), 1.0, math.nan
     gain, gain_sd = through_origin([turn.odometry for turn in turns], [turn.truth for turn in turns])
