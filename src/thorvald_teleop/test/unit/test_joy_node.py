@@ -176,8 +176,24 @@ def run(ros_env, tmp_path):
             p.close()
 
 
-def plug(path, timeout=TIMEOUT):
-    """Opens the FIFO for writing, as a joystick plugged in: returns once joy_node has opened it too."""
+def plug(path, burst, timeout=TIMEOUT):
+    """Opens the FIFO for writing, as a joystick plugged in, and writes its opening burst: returns the
+    writer once joy_node has it. The reader the open meets may be joy_node's last look at an empty FIFO,
+    closing after the end of file it read (the write then breaks the pipe): then plugged again."""
+    deadline = time.monotonic() + timeout
+    while True:
+        writer = _open_writer(path, timeout)
+        try:
+            os.write(writer, burst)
+            return writer
+        except BrokenPipeError:
+            os.close(writer)
+            if time.monotonic() > deadline:
+                pytest.fail(f"joy_node closed {path} after each open for {timeout} s")
+
+
+def _open_writer(path, timeout):
+    """Opens the FIFO for writing: returns once a reader (joy_node) has it open too."""
     opened = {}
     opener = threading.Thread(target=lambda: opened.setdefault("fd", os.open(path, os.O_WRONLY)), daemon=True)
     opener.start()
@@ -221,8 +237,7 @@ def test_events_unplug_and_replug(run, tmp_path):
     assert joy.pending_joys() == []
 
     # an Xbox pad: 11 buttons (Y held), 8 axes, the triggers (2 and 5) at rest at -32767
-    writer = plug(fifo)
-    os.write(writer, init_burst([0, 0, 0, 1] + [0] * 7, [0, 0, -32767, 0, 0, -32767, 0, 0]))
+    writer = plug(fifo, init_burst([0, 0, 0, 1] + [0] * 7, [0, 0, -32767, 0, 0, -32767, 0, 0]))
     first = joy.next_joy()
     assert first["buttons"] == [0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0]
     assert first["axes"] == [0.0] * 8  # initial axis values are not taken (the joy package's default)
@@ -265,8 +280,7 @@ def test_events_unplug_and_replug(run, tmp_path):
     assert "published a neutral Joy" in warnings[1]
 
     # plugged again, a smaller pad: its own sizes; the message after the neutral one is the new state
-    writer = plug(fifo)
-    os.write(writer, init_burst([0, 0, 1, 0], [0, 0]))
+    writer = plug(fifo, init_burst([0, 0, 1, 0], [0, 0]))
     m = joy.next_joy()
     assert m["axes"] == [0.0, 0.0] and m["buttons"] == [0, 0, 1, 0]
     joy.wait_diag(OK, "connected")
@@ -291,8 +305,7 @@ def test_a_missing_device_then_autorepeat(run, tmp_path):
 
     # the device appears
     os.mkfifo(str(dev))
-    writer = plug(str(dev))
-    os.write(writer, init_burst([0, 0], [0, 0]))
+    writer = plug(str(dev), init_burst([0, 0], [0, 0]))
     m = joy.next_joy()
     assert m["axes"] == [0.0, 0.0] and m["buttons"] == [0, 0]
     joy.wait_diag(OK, "connected")
