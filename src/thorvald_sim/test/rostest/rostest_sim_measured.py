@@ -78,9 +78,13 @@ class SimMeasuredTest(unittest.TestCase):
 
     def test_the_currents_come_at_their_own_rate_and_the_states_at_theirs(self):
         # drive_currents at ~drive_current_rate (10 Hz: base_driver reports them at 1 Hz), drive_states at 80 Hz
-        stamps = {"drive_currents": [], "drive_states": []}
+        stamps = {"drive_currents": [], "drive_states": []}  # (stamp, seq) as delivered
         subs = [
-            rospy.Subscriber(f"/tarmac/{topic}", msg_type, lambda m, t=topic: stamps[t].append(m.header.stamp.to_sec()))
+            rospy.Subscriber(
+                f"/tarmac/{topic}",
+                msg_type,
+                lambda m, t=topic: stamps[t].append((m.header.stamp.to_sec(), m.header.seq)),
+            )
             for topic, msg_type in (("drive_currents", DriveCurrents), ("drive_states", BaseState))
         ]
         # The window is the stamps' own, not the test's clock: it opens 0.2 s after the first message of
@@ -91,16 +95,25 @@ class SimMeasuredTest(unittest.TestCase):
         while not all(stamps.values()):
             self.assertLess(time.time(), deadline, "no drive_currents and drive_states")
             time.sleep(0.05)
-        start = max(times[0] for times in stamps.values()) + 0.2
-        while not all(times[-1] >= start + 2.1 for times in stamps.values()):
+        start = max(times[0][0] for times in stamps.values()) + 0.2
+        while not all(times[-1][0] >= start + 2.1 for times in stamps.values()):
             self.assertLess(time.time(), deadline, f"no messages stamped after {start + 2.1:.2f} s")
             time.sleep(0.05)
         for sub in subs:
             sub.unregister()
         for topic, rate in (("drive_currents", 10.0), ("drive_states", 80.0)):
-            within = [t for t in stamps[topic] if start <= t < start + 2.0]
-            self.assertAlmostEqual(len(within), 2.0 * rate, delta=1, msg=topic)
-            self.assertAlmostEqual(float(np.median(np.diff(within))), 1.0 / rate, delta=0.2 / rate, msg=topic)
+            within = [(t, seq) for t, seq in stamps[topic] if start <= t < start + 2.0]
+            # What the simulator published is counted by the messages' sequence numbers: a reader that
+            # does not keep up misses messages (the simulator never waits for one), and this test's
+            # reader on a loaded machine missed 6 of 160 drive states in one CI run at 3x real time.
+            published = within[-1][1] - within[0][1] + 1
+            missed = published - len(within)
+            rospy.loginfo("%s: %d published in 2 s of stamps, %d missed by this reader", topic, published, missed)
+            self.assertAlmostEqual(published, 2.0 * rate, delta=1, msg=topic)
+            # the period between messages the reader got, per message published between them
+            periods = [(t1 - t0) / (s1 - s0) for (t0, s0), (t1, s1) in zip(within, within[1:])]
+            self.assertAlmostEqual(float(np.median(periods)), 1.0 / rate, delta=0.2 / rate, msg=topic)
+            self.assertLess(missed, 0.25 * published, msg=f"{topic}: this reader missed most messages")
 
     def test_on_ice_ground_truth_falls_behind_odometry(self):
         truth, odom = self.drive("ice", 1.5)
