@@ -1,5 +1,5 @@
 """rosrun thorvald_design design_study, end to end: two candidates through every scenario, the results
-checked against the quasi-static limits and the closed forms, and repeated to the byte."""
+checked against the quasi-static limits and the closed forms, and repeated to the byte on a Dask cluster."""
 
 import csv
 import json
@@ -52,24 +52,30 @@ def design_study(*args, timeout=600):
 
 @pytest.fixture(scope="module")
 def study(tmp_path_factory):
-    """The study run twice into two folders: (the first's results, its folder, the second's folder)."""
+    """The study run twice into two folders, on local worker processes (--jobs 2), then on a local Dask
+    cluster of two worker processes (--scheduler): (the first's results, its folder, the second's
+    folder, the second's process)."""
+    from distributed import LocalCluster  # noqa: PLC0415
+
     root = tmp_path_factory.mktemp("study")
     path = root / "study.yaml"
     path.write_text(STUDY)
-    runs = []
-    for name in ("first", "second"):
-        done = design_study(str(path), "--out", str(root / name), "--jobs", "2")
-        assert done.returncode == 0, done.stderr[-3000:]
-        runs.append(root / name)
-    with open(runs[0] / "results.json", encoding="utf-8") as f:
-        return json.load(f), runs[0], runs[1], done
+    first = design_study(str(path), "--out", str(root / "first"), "--jobs", "2")
+    assert first.returncode == 0, first.stderr[-3000:]
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+    ) as cluster:
+        second = design_study(str(path), "--out", str(root / "second"), "--scheduler", cluster.scheduler_address)
+    assert second.returncode == 0, second.stderr[-3000:]
+    with open(root / "first" / "results.json", encoding="utf-8") as f:
+        return json.load(f), root / "first", root / "second", second
 
 
 def example(name):
     return design_of(name, package_file("config", name, name + ".yaml"))
 
 
-@pytest.mark.slow  # two studies of 8 runs each, in worker processes
+@pytest.mark.slow  # two studies of 8 runs each, in worker processes and on a Dask cluster
 def test_every_candidate_has_every_scenarios_metrics(study):
     results, first, _, done = study
     assert set(results["candidates"]) == {"std", "fwd"}
@@ -196,7 +202,7 @@ def test_steps_and_energy(study):
     assert fwd["energy"]["wh_per_km"].startswith("n/a: it tipped over")
 
 
-@pytest.mark.slow
+@pytest.mark.slow  # once on local worker processes, once on a Dask cluster: the study fixture
 def test_the_same_study_gives_the_same_files_byte_for_byte(study):
     _, first, second, _ = study
     for name in ("results.json", "results.csv", "candidates/std.yaml", "candidates/fwd.yaml", "report.html"):
@@ -333,33 +339,13 @@ def test_optimise_without_a_section_is_refused(tmp_path):
     assert done.returncode == 2 and "--optimise needs an optimise: section" in done.stderr
 
 
-SMALL = """\
-candidates:
-  std: {robot: thorvald_ii_4wd4ws_std}
-  fwd: {robot: thorvald_ii_1wd1ws_fwd}
-scenarios:
-  turning: {settle: 1}
-  drawbar: {surface: grass, step_n: 100, hold_s: 1.0}
-"""
-
-
-@pytest.mark.slow  # a Dask cluster of two worker processes on this machine's loopback, and the same runs locally
-def test_a_study_runs_on_a_dask_cluster_to_the_same_results(tmp_path):
-    """The same study on a local Dask cluster of two workers (--scheduler) and on local worker
-    processes gives the same results.json."""
-    from distributed import LocalCluster  # noqa: PLC0415
-
-    path = tmp_path / "study.yaml"
-    path.write_text(SMALL)
-    local = design_study(str(path), "--out", str(tmp_path / "local"), "--jobs", "2")
-    assert local.returncode == 0, local.stderr[-3000:]
-    with LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
-    ) as cluster:
-        done = design_study(str(path), "--out", str(tmp_path / "dask"), "--scheduler", cluster.scheduler_address)
-    assert done.returncode == 0, done.stderr[-3000:]
+@pytest.mark.slow
+def test_a_study_runs_on_a_dask_cluster_to_the_same_results(study):
+    """The study's second run, on a local Dask cluster of two workers (--scheduler), gives the results
+    the first gave on local worker processes (every file, byte for byte: the test above)."""
+    _, first, second, done = study
     assert "2 Dask workers at tcp://127.0.0.1:" in done.stderr
-    assert (tmp_path / "dask" / "results.json").read_bytes() == (tmp_path / "local" / "results.json").read_bytes()
+    assert (second / "results.json").read_bytes() == (first / "results.json").read_bytes()
 
 
 @pytest.mark.slow  # a process
