@@ -53,7 +53,7 @@ from thorvald_base.calibration.calibration_file import read_calibration
 from thorvald_base.calibration.turns import TURNING, drive_turns
 from thorvald_base.calibration_cli import read_bag
 from thorvald_base.kinematics.calculator import NO_CORRECTION
-from thorvald_model import load_robot_config, with_drive_param
+from thorvald_model import load_robot_config, with_drive_params
 from thorvald_model.description import package_file
 
 DISTANCE, END = 0.2, 0.5  # [%], [m]: issue 46's targets
@@ -83,8 +83,7 @@ def turn_kinds(base: str):
     robot = os.path.basename(base).rsplit("_", 1)[0]
     config = load_robot_config(package_file("config", robot, robot + ".yaml"))
     values = read_calibration(os.path.join(base, "calibration", "calibration.yaml"), config)
-    for index, key, value in values.changes:
-        config = with_drive_param(config, index, key, value)
+    config = with_drive_params(config, values.changes)
     model = values.odometry or NO_CORRECTION
     multiplier = model.yaw_rate_multiplier
     unit = dataclasses.replace(model, yaw_rate_multiplier=1.0)

@@ -44,7 +44,7 @@ from typing import List, Optional, Sequence, Tuple
 import numpy as np
 import rospy
 
-from thorvald_model import ConfigError, with_drive_param
+from thorvald_model import ConfigError, with_drive_params
 from thorvald_model.motors import Motor, output_torque, propulsion_motor
 from thorvald_msgs.msg import ControllerArray, DriveParam
 from thorvald_msgs.srv import DriveParams
@@ -69,9 +69,7 @@ class BalanceDrive(VerificationDrive):
         path = str(rospy.get_param("~calibration", "") or "")
         self.in_effect = read_calibration(path, self.config) if path else CalibrationValues()
         self.calibration = list(self.in_effect.changes)
-        config = self.config
-        for index, key, value in self.calibration:
-            config = with_drive_param(config, index, key, value)
+        config = with_drive_params(self.config, self.calibration)
         self.out = str(rospy.get_param("~out", "") or "")
         self.json = str(rospy.get_param("~json", "") or "")
         self.windows: List[BalanceWindow] = balance_legs(self.plan)

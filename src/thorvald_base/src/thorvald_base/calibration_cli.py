@@ -27,7 +27,7 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 import rosbag
 
-from thorvald_model import ConfigError, load_robot_config, with_drive_param
+from thorvald_model import ConfigError, load_robot_config, with_drive_params
 
 from .bag_topics import lost_messages, lost_sentence, topics_by_ending
 from .calibration import (
@@ -224,8 +224,7 @@ def run(args) -> int:
     if args.calibration:
         values = read_calibration(args.calibration, robot)
         earlier, odometry = list(values.changes), values.odometry
-        for index, key, value in earlier:
-            in_effect = with_drive_param(in_effect, index, key, value)
+        in_effect = with_drive_params(in_effect, earlier)
     if args.fit in ("scale", "straight", "turns", "heading") and args.balance:
         raise CalibrationError(
             f"--balance goes with --fit drives or odometry: --fit {args.fit} keeps every radius's share"
@@ -288,9 +287,7 @@ def with_balance(calibration: Calibration, observable: Optional[ObservableFit], 
     determine (with the simulator's ground truth: observable given), or the balanced radii scaled to the
     calibration's geometric mean and the balance's offsets as they are (GNSS: the toe search kept the
     crab and arc it started with)."""
-    config = robot
-    for index, key, value in balanced:
-        config = with_drive_param(config, index, key, value)
+    config = with_drive_params(robot, balanced)
     radii = [d.r_wheel for d in config.drives]
     toe = {index for index, key, _ in balanced if key == "steering_offset"}
     offsets = [d.steering_offset for d in config.drives] if toe else None

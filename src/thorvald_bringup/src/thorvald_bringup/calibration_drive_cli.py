@@ -57,7 +57,7 @@ from thorvald_base.calibration.calibration_file import load_calibration
 from thorvald_base.calibration.toe_balance import toe_gauge
 from thorvald_base.calibration.torque_balance import relative_errors
 from thorvald_base.verification import SIDE
-from thorvald_model import ConfigError, load_robot_config, with_drive_param
+from thorvald_model import ConfigError, load_robot_config, with_drive_params
 from thorvald_sim.physics.as_built import PROFILES, as_built_for
 
 from .errors import DriveError, ThorvaldBringupError
@@ -331,10 +331,7 @@ def toe_errors(config, built, odometry_changes, balanced) -> dict:
         e = np.asarray(offsets) - truth
         return float(np.degrees(np.max(np.abs(e - gauge @ (gauge.T @ e)))))
 
-    fitted = config
-    for index, key, value in odometry_changes:
-        fitted = with_drive_param(fitted, index, key, value)
-    start = [d.steering_offset for d in fitted.drives]
+    start = [d.steering_offset for d in with_drive_params(config, odometry_changes).drives]
     found = list(start)
     for name, values in balanced["toe"]["drives"].items():
         found[int(name[len("drive") :])] = values["steering_offset"]
@@ -350,10 +347,7 @@ def tyre_errors(config, built, odometry_changes, balanced, final_changes) -> dic
     truth = [d.r_wheel for d in built.drives]
 
     def radii(changes):
-        fitted = config
-        for index, key, value in changes:
-            fitted = with_drive_param(fitted, index, key, value)
-        return [d.r_wheel for d in fitted.drives]
+        return [d.r_wheel for d in with_drive_params(config, changes).drives]
 
     sets = {
         "configured": radii([]),

@@ -8,6 +8,7 @@ from .config import (
     load_robot_config,
     parse_robot_config,
     with_drive_param,
+    with_drive_params,
 )
 from .errors import ConfigError, ThorvaldModelError
 
@@ -20,4 +21,5 @@ __all__ = [
     "load_robot_config",
     "parse_robot_config",
     "with_drive_param",
+    "with_drive_params",
 ]

@@ -20,7 +20,7 @@ path, the value and the rule, and raised together in one :class:`ConfigError`.
 import logging
 import re
 from dataclasses import replace
-from typing import Any, Dict, Iterable, List
+from typing import Any, Dict, Iterable, List, Tuple
 
 from .constants import DIFF_CALCULATOR, DRIVE_DIFF, DRIVE_STEERED, ONE_WHEEL_CALCULATOR, STD_CALCULATOR
 from .errors import MISSING, ConfigError, Problem
@@ -213,12 +213,22 @@ def description_dict(config: RobotConfig) -> Dict[str, Any]:
 
 def with_drive_param(config: RobotConfig, index: int, key: str, value: Any) -> RobotConfig:
     """A copy with ``motor_drives/drive<index>/<key>`` set to value, validated like a file."""
+    return with_drive_params(config, [(index, key, value)])
+
+
+def with_drive_params(config: RobotConfig, changes: Iterable[Tuple[int, str, Any]]) -> RobotConfig:
+    """A copy with each change (drive index, key, value) set, as a calibration file or set_drive_params
+    gives them, validated like a file once (config itself when there is none)."""
+    changes = list(changes)
+    if not changes:
+        return config
     data = config_to_dict(config)
     drives = data.get("motor_drives", {})
-    name = f"drive{index}"
-    if name not in drives:
-        raise ConfigError(config.source, [Problem("motor_drives." + name, MISSING, "no such drive")])
-    drives[name][key] = value
+    for index, key, value in changes:
+        name = f"drive{index}"
+        if name not in drives:
+            raise ConfigError(config.source, [Problem("motor_drives." + name, MISSING, "no such drive")])
+        drives[name][key] = value
     return parse_robot_config(data, config.source)
 
 
@@ -246,4 +256,5 @@ __all__ = [
     "load_robot_config",
     "parse_robot_config",
     "with_drive_param",
+    "with_drive_params",
 ]

@@ -7,7 +7,14 @@ import pytest
 import yaml
 from model_test_helpers import EXAMPLE_ROBOTS, FIGURE5, std_drive
 
-from thorvald_model import ConfigError, config_to_dict, load_robot_config, parse_robot_config, with_drive_param
+from thorvald_model import (
+    ConfigError,
+    config_to_dict,
+    load_robot_config,
+    parse_robot_config,
+    with_drive_param,
+    with_drive_params,
+)
 from thorvald_model.config import STD_CALCULATOR
 
 
@@ -582,3 +589,16 @@ def test_drive_parameter_changed_at_run_time(robot):
     with pytest.raises(ConfigError) as info:
         with_drive_param(config, 2, "r_wheel", -1)
     assert info.value.problems[0].path == "motor_drives.drive2.r_wheel"
+
+
+def test_drive_parameters_changed_together_are_the_changes_one_by_one(robot):
+    config = parse_robot_config(robot)
+    changes = [(0, "r_wheel", 0.21), (2, "steering_offset", 0.01), (3, "r_wheel", 0.19)]
+    one_by_one = config
+    for index, key, value in changes:
+        one_by_one = with_drive_param(one_by_one, index, key, value)
+    assert with_drive_params(config, changes) == one_by_one
+    assert with_drive_params(config, []) is config
+    with pytest.raises(ConfigError) as info:
+        with_drive_params(config, [(0, "r_wheel", 0.21), (9, "r_wheel", 0.2)])
+    assert info.value.problems[0].path == "motor_drives.drive9"

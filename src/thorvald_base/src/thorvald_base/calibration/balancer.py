@@ -30,7 +30,7 @@ from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from thorvald_model import ConfigError, RobotConfig, with_drive_param
+from thorvald_model import ConfigError, RobotConfig, with_drive_params
 
 from ..errors import CalibrationError
 from .toe_balance import ToeSearch, resistance
@@ -117,12 +117,13 @@ class Balancer:
 
     def allowed(self, radii: Sequence[float], offsets: Sequence[float]) -> None:
         """CalibrationError with the rule if the robot file's rules refuse these radii and offsets."""
-        config = self.config
+        changes = []
+        for k, (r, o) in enumerate(zip(radii, offsets)):
+            changes.append((k, "r_wheel", r))
+            if self.config.drives[k].steerable:
+                changes.append((k, "steering_offset", o))
         try:
-            for k, (r, o) in enumerate(zip(radii, offsets)):
-                config = with_drive_param(config, k, "r_wheel", r)
-                if config.drives[k].steerable:
-                    config = with_drive_param(config, k, "steering_offset", o)
+            with_drive_params(self.config, changes)
         except ConfigError as e:
             raise CalibrationError(
                 "the robot file's rules refuse what the balance would set: " + str(e).replace("\n", " ")

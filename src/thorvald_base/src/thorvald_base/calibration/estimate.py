@@ -68,7 +68,7 @@ from typing import List, Optional, Tuple, Union
 
 import numpy as np
 
-from thorvald_model import with_drive_param
+from thorvald_model import with_drive_params
 from thorvald_model.values import RobotConfig
 
 from ..errors import CalibrationError
@@ -131,9 +131,7 @@ class Calibration:
 
     def calibrated(self, config: RobotConfig) -> RobotConfig:
         """The configuration in effect with the estimates, validated as a robot file (ConfigError)."""
-        for index, key, value in self.changes():
-            config = with_drive_param(config, index, key, value)
-        return config
+        return with_drive_params(config, self.changes())
 
 
 class _Problem:

@@ -41,7 +41,7 @@ from typing import Callable, List, Optional, Tuple, Union
 
 import numpy as np
 
-from thorvald_model import with_drive_param
+from thorvald_model import with_drive_params
 from thorvald_model.values import RobotConfig
 
 from ..errors import CalibrationError
@@ -173,9 +173,7 @@ def _legs(config, recording, truth, calculator_for, correction: OdometryCorrecti
 def _with_heading(fit: ScaleFit, config, recording, truth, calculator_for) -> ScaleFit:
     """The fit with odometry's yaw_per_metre from the legs' heading (the module's docstring), the
     legs replayed with the radii's factor applied."""
-    scaled = config
-    for i, drive in enumerate(config.drives):
-        scaled = with_drive_param(scaled, i, "r_wheel", drive.r_wheel * fit.factor)
+    scaled = with_drive_params(config, [(i, "r_wheel", d.r_wheel * fit.factor) for i, d in enumerate(config.drives)])
     legs = _legs(scaled, as_read_with(recording, config, scaled), truth, calculator_for, fit.in_effect)
     used = [leg for leg, first in zip(legs, fit.legs) if first.straight] if len(legs) == len(fit.legs) else []
     if not used:
