@@ -8,7 +8,7 @@ import pytest
 import roslaunch.config
 import roslaunch.xmlloader
 
-pytestmark = pytest.mark.slow  # a process per case: the commands as a user types them
+pytestmark = [pytest.mark.slow, pytest.mark.long(13)]  # a process per case: the commands as a user types them
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 BRINGUP = os.path.join(HERE, "..", "src", "thorvald_bringup", "launch")

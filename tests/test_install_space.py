@@ -20,7 +20,7 @@ import pytest
 
 from thorvald_testing import free_port
 
-pytestmark = [pytest.mark.ros, pytest.mark.slow]
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.long(35)]
 
 WS = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 VENV_PYTHON = os.path.join(WS, ".venv", "bin", "python")

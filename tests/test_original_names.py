@@ -29,6 +29,9 @@ ROBOTS = sorted(os.listdir(os.path.join(SRC, "thorvald_model", "config")))
 STARTUP = 90.0  # [s] for the simulator and the robot's nodes on a busy machine
 
 
+pytestmark = pytest.mark.long(35)  # [s] in all: the parallel run starts it early
+
+
 def package(name):
     return rospkg.RosPack().get_path(name)
 

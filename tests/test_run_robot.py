@@ -18,7 +18,7 @@ import pytest
 from thorvald_model.description import package_file as model_file
 from thorvald_sim.tools.runner import RunOptions, TimedTwist, read_commands, run_robot, write_commands
 
-pytestmark = [pytest.mark.ros, pytest.mark.slow]
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.long(20)]
 
 ROBOT = "thorvald_ii_4wd4ws_std"
 ROBOT_FILE = model_file("config", ROBOT, ROBOT + ".yaml")

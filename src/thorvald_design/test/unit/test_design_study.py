@@ -13,7 +13,7 @@ import pytest
 from thorvald_design.design import design_of
 from thorvald_model.description import package_file
 
-pytestmark = pytest.mark.long(130)  # studies run end to end
+pytestmark = pytest.mark.long(150)  # studies run end to end
 
 STUDY = """\
 description: "two robots, every scenario, short"

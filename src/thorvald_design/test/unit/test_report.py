@@ -35,6 +35,9 @@ CHROMIUM = "/usr/bin/chromium"
 
 
 # ---- the Pareto front ---------------------------------------------------------------------------------
+pytestmark = pytest.mark.long(20)  # [s] in all: the parallel run starts it early
+
+
 @pytest.mark.parametrize(
     ("points", "directions", "front"),
     [

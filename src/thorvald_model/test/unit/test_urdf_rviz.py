@@ -18,7 +18,7 @@ from thorvald_model.rviz_capture import (
     xvfb,
 )
 
-pytestmark = [pytest.mark.ros, pytest.mark.slow]
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.long(12)]
 
 STD = os.path.join(PKG, "config", "thorvald_ii_4wd4ws_std", "thorvald_ii_4wd4ws_std.yaml")
 WIDTH, HEIGHT = 640, 480

@@ -19,6 +19,9 @@ ASYM = package_file("config", "thorvald_ii_6wd6ws_asym", "thorvald_ii_6wd6ws_asy
 LEG, SETTLE, PAUSE = 6.0, 2.0, 1.0  # [s]
 
 
+pytestmark = pytest.mark.long(15)  # [s] in all: the parallel run starts it early
+
+
 def torques(session, radii, speed):
     """The wheels' torques from the currents the controllers report, as balance_wheels reads them."""
     config = session.config

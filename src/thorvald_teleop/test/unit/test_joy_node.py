@@ -22,6 +22,8 @@ from thorvald_testing import START, stop_group
 TIMEOUT = 10.0  # [s] for a message that should come
 OK, ERROR = 0, 2
 
+pytestmark = pytest.mark.long(11)  # [s] in all: the parallel run starts it early
+
 LISTENER = r"""
 import json, sys
 import rospy

@@ -25,6 +25,8 @@ import pytest
 from thorvald_teleop.keyboard_node import RawTerminal
 from thorvald_testing import START, children, poll, stop_group
 
+pytestmark = pytest.mark.long(11)  # [s] in all: the parallel run starts it early
+
 
 @pytest.fixture(autouse=True)
 def _tmux_and_ros():

@@ -21,6 +21,8 @@ from thorvald_testing import (
     processes_naming,
 )
 
+pytestmark = pytest.mark.long(25)  # [s] in all: the parallel run starts it early
+
 
 def gone_pid():
     """A pid nobody has: a process that has exited and been reaped."""
