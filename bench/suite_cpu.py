@@ -56,15 +56,26 @@ def main(argv):
         out = os.path.join(tmp, "rows")
         os.mkdir(out)
         env = dict(os.environ, SUITE_CPU_OUT=out, PYTHONPATH=tmp + os.pathsep + os.environ.get("PYTHONPATH", ""))
-        stage = args.pytest_args or ["-n", str(args.workers), "--dist", "loadfile", "--no-loadscope-reorder"]
-        stage = stage + ([] if args.pytest_args else ["-m", "not solo"])
+        # tools/run-tests' parallel stage, unless pytest's arguments were given
+        stage = args.pytest_args or [
+            "-n",
+            str(args.workers),
+            "--dist",
+            "loadfile",
+            "--no-loadscope-reorder",
+            "-m",
+            "not solo",
+        ]
         cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "suite_cpu_plugin", *stage]
         started = time.time()
         before = os.times()
         done = subprocess.run(cmd, cwd=ws, env=env)
         after = os.times()
         wall = time.time() - started
-        rows = [row for path in glob.glob(os.path.join(out, "*.json")) for row in json.load(open(path))]
+        rows = []
+        for path in glob.glob(os.path.join(out, "*.json")):
+            with open(path) as f:
+                rows += json.load(f)
     by_file = collections.defaultdict(lambda: [0.0, 0.0, 0])
     for node, seconds, cpu in rows:
         entry = by_file[node.split("::")[0]]
